@@ -1,0 +1,47 @@
+//! Point clouds, organised scans, range images, sensor poses and their file formats.
+//!
+//! This is the vocabulary every other crate of the workspace speaks about range data:
+//!
+//! * [`PointCloud`]: finite positions plus optional per-point attributes (intensity or amplitude,
+//!   normals, labels, rings, any extra scalar field a file carried). A cloud may be *organised*
+//!   ([`Grid`]): then it remembers the image it came from, pixel by pixel, and pixels without a
+//!   measurement are explicit ([`Grid::point_index`] returns `None` for them).
+//! * [`RangeImage`]: a `width × height` image of ranges with a [`BeamModel`] (pinhole, spherical,
+//!   or actuated laser range finder) that gives every pixel its beam direction.
+//! * [`SensorPose`]: a `world_from_sensor` rigid transform.
+//! * [`Aabb`]: an axis-aligned box.
+//! * [`io`]: readers and writers for PLY, PCD v0.7, OBJ, XYZ, KITTI `.bin`, 3DTK `.3d`/`.pose`
+//!   and 16-bit PNG depth images. Every reader returns a typed [`io::Error`] that names the file
+//!   position on corrupt input; none panics.
+//!
+//! All geometry is `f64` and uses [`nalgebra`] types, re-exported as [`na`].
+//!
+//! # Frames
+//! Names carry the frame: `world_from_sensor * point_in_sensor` is a point in the world. The
+//! world frame is right-handed with z up. Camera-like sensors use the optical frame (x right,
+//! y down, z forward); laser range finders use x forward, y left, z up.
+
+pub extern crate nalgebra as na;
+
+mod aabb;
+mod cloud;
+pub mod io;
+mod pose;
+mod range_image;
+
+pub use aabb::Aabb;
+pub use cloud::{AttributeError, FieldData, Grid, PointCloud, ScalarField, INVALID_PIXEL};
+pub use pose::SensorPose;
+pub use range_image::{
+    ActuatedLrfModel, BeamModel, PinholeIntrinsics, RangeImage, RangeImageError, RangeKind,
+    SphericalModel,
+};
+
+/// The one scalar type of the workspace.
+pub type Real = f64;
+/// A point in 3D.
+pub type Point3 = na::Point3<Real>;
+/// A vector in 3D.
+pub type Vector3 = na::Vector3<Real>;
+/// A rigid transform in 3D.
+pub type Isometry3 = na::Isometry3<Real>;
