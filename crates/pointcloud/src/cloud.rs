@@ -128,10 +128,9 @@ impl Grid {
             if p == INVALID_PIXEL {
                 continue;
             }
-            let slot = seen.get_mut(p as usize).ok_or(AttributeError::GridIndex {
-                index: p,
-                num_points,
-            })?;
+            let slot = seen
+                .get_mut(p as usize)
+                .ok_or(AttributeError::GridIndex { index: p, num_points })?;
             if *slot {
                 return Err(AttributeError::GridDuplicate { index: p });
             }
@@ -512,10 +511,12 @@ mod tests {
 
     #[test]
     fn non_finite_positions_are_refused() {
-        let err = PointCloud::from_positions(vec![Point3::origin(), Point3::new(f64::NAN, 0.0, 0.0)])
-            .unwrap_err();
+        let err =
+            PointCloud::from_positions(vec![Point3::origin(), Point3::new(f64::NAN, 0.0, 0.0)])
+                .unwrap_err();
         assert_eq!(err, AttributeError::NonFinite { index: 1 });
-        let err = PointCloud::from_positions(vec![Point3::new(0.0, f64::INFINITY, 0.0)]).unwrap_err();
+        let err =
+            PointCloud::from_positions(vec![Point3::new(0.0, f64::INFINITY, 0.0)]).unwrap_err();
         assert_eq!(err, AttributeError::NonFinite { index: 0 });
     }
 
@@ -534,7 +535,8 @@ mod tests {
 
     #[test]
     fn organised_cloud_keeps_invalid_pixels_explicit() {
-        let px = vec![Some(Point3::new(1.0, 0.0, 0.0)), None, None, Some(Point3::new(0.0, 1.0, 0.0))];
+        let px =
+            vec![Some(Point3::new(1.0, 0.0, 0.0)), None, None, Some(Point3::new(0.0, 1.0, 0.0))];
         let c = PointCloud::from_pixels(2, 2, px).unwrap();
         let g = c.grid().unwrap();
         assert_eq!(c.len(), 2);
@@ -565,7 +567,10 @@ mod tests {
 
     #[test]
     fn grid_rejects_bad_tables() {
-        assert!(matches!(Grid::new(2, 1, vec![0, 0], 1), Err(AttributeError::GridDuplicate { .. })));
+        assert!(matches!(
+            Grid::new(2, 1, vec![0, 0], 1),
+            Err(AttributeError::GridDuplicate { .. })
+        ));
         assert!(matches!(Grid::new(2, 1, vec![0, 5], 2), Err(AttributeError::GridIndex { .. })));
         assert!(matches!(
             Grid::new(2, 1, vec![0, INVALID_PIXEL], 2),

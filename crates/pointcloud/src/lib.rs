@@ -30,7 +30,7 @@ mod pose;
 mod range_image;
 
 pub use aabb::Aabb;
-pub use cloud::{AttributeError, FieldData, Grid, PointCloud, ScalarField, INVALID_PIXEL};
+pub use cloud::{AttributeError, FieldData, Grid, INVALID_PIXEL, PointCloud, ScalarField};
 pub use pose::SensorPose;
 pub use range_image::{
     ActuatedLrfModel, BeamModel, PinholeIntrinsics, RangeImage, RangeImageError, RangeKind,

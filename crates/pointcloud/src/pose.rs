@@ -22,9 +22,7 @@ impl SensorPose {
     /// yaw about z, then pitch about y, then roll about x: `R = Rz(yaw) Ry(pitch) Rx(roll)`).
     pub fn from_position_rpy(position: Point3, roll: Real, pitch: Real, yaw: Real) -> SensorPose {
         let rotation = na::UnitQuaternion::from_euler_angles(roll, pitch, yaw);
-        SensorPose {
-            world_from_sensor: Isometry3::from_parts(position.coords.into(), rotation),
-        }
+        SensorPose { world_from_sensor: Isometry3::from_parts(position.coords.into(), rotation) }
     }
 
     /// The sensor origin in the world frame.
