@@ -38,6 +38,11 @@ macro_rules! for_each_field {
     };
 }
 
+#[allow(clippy::unnecessary_cast)] // the macro body is shared by every variant, f64 included
+fn field_as_f64(data: &FieldData, i: usize) -> Option<f64> {
+    for_each_field!(data, v => v.get(i).map(|&x| x as f64))
+}
+
 impl FieldData {
     /// The number of values.
     pub fn len(&self) -> usize {
@@ -51,7 +56,7 @@ impl FieldData {
 
     /// Value `i` as `f64` (exact for every stored type).
     pub fn get_f64(&self, i: usize) -> Option<f64> {
-        for_each_field!(self, v => v.get(i).map(|&x| x as f64))
+        field_as_f64(self, i)
     }
 
     /// An empty field of the same type.
@@ -399,13 +404,13 @@ impl PointCloud {
     /// Organises the cloud as an image (see [`Grid::new`] for what is checked), or makes it
     /// unorganised with `None`.
     pub fn set_grid(&mut self, grid: Option<Grid>) -> Result<(), AttributeError> {
-        if let Some(g) = &grid {
-            if g.num_valid() != self.len() {
-                return Err(AttributeError::GridUncovered {
-                    valid: g.num_valid(),
-                    num_points: self.len(),
-                });
-            }
+        if let Some(g) = &grid
+            && g.num_valid() != self.len()
+        {
+            return Err(AttributeError::GridUncovered {
+                valid: g.num_valid(),
+                num_points: self.len(),
+            });
         }
         self.grid = grid;
         Ok(())
@@ -439,9 +444,9 @@ impl PointCloud {
     pub fn retain_indices(&self, mut keep: impl FnMut(usize) -> bool) -> PointCloud {
         let mut new_index = vec![INVALID_PIXEL; self.len()];
         let mut kept = Vec::new();
-        for i in 0..self.len() {
+        for (i, slot) in new_index.iter_mut().enumerate() {
             if keep(i) {
-                new_index[i] = kept.len() as u32;
+                *slot = kept.len() as u32;
                 kept.push(i);
             }
         }

@@ -178,10 +178,10 @@ impl RangeImage {
             return Err(RangeImageError::DepthNeedsPinhole);
         }
         for (index, r) in ranges.iter().enumerate() {
-            if let Some(value) = *r {
-                if !(value.is_finite() && value >= 0.0) {
-                    return Err(RangeImageError::BadRange { index, value });
-                }
+            if let Some(value) = *r
+                && !(value.is_finite() && value >= 0.0)
+            {
+                return Err(RangeImageError::BadRange { index, value });
             }
         }
         Ok(RangeImage { width, height, beams, kind, ranges })
