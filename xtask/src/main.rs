@@ -1,1 +1,84 @@
-fn main() {}
+//! Project automation, run as `cargo xtask <command>` (see `.cargo/config.toml`).
+//!
+//! * `cargo xtask fixtures [--check]`: regenerates the small committed files in `fixtures/`
+//!   deterministically from our own simulator (`--check` only compares).
+//! * `cargo xtask bench [NAME ...] [--seed N] [--out FILE]`: runs named benchmarks of the
+//!   `bench-matrix` program in release mode and appends one JSON line per measurement, with the
+//!   provenance of the run (git revision, host, CPU, date, seed), to `target/bench/results.jsonl`.
+
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+mod bench;
+mod fixtures;
+mod provenance;
+
+const USAGE: &str = "\
+usage: cargo xtask <command>
+
+commands:
+  fixtures [--check]                    regenerate fixtures/ (or check they are current)
+  bench [NAME ...] [--seed N] [--out F] run named benchmarks (default: all), append JSONL rows
+  bench --list                          list the benchmark names
+";
+
+fn main() -> ExitCode {
+    match try_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn try_main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some((command, rest)) = args.split_first() else {
+        print!("{USAGE}");
+        return Ok(());
+    };
+    match command.as_str() {
+        "fixtures" => {
+            let check = match rest {
+                [] => false,
+                [flag] if flag == "--check" => true,
+                _ => bail!("fixtures takes only --check\n\n{USAGE}"),
+            };
+            let dir = project_root().join("fixtures");
+            if check {
+                let stale = fixtures::check(&dir)?;
+                if !stale.is_empty() {
+                    bail!("fixtures are stale: {} (run `cargo xtask fixtures`)", stale.join(", "));
+                }
+                println!("fixtures are current");
+            } else {
+                for name in fixtures::write_all(&dir)? {
+                    println!("wrote fixtures/{name}");
+                }
+            }
+            Ok(())
+        }
+        "bench" => bench::run(rest),
+        "help" | "--help" | "-h" => {
+            print!("{USAGE}");
+            Ok(())
+        }
+        other => bail!("unknown command `{other}`\n\n{USAGE}"),
+    }
+}
+
+/// The workspace root (the parent of this crate's directory).
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
+}
+
+/// Runs a command and returns its standard output, failing with its standard error.
+fn capture(cmd: &mut std::process::Command) -> Result<String> {
+    let out = cmd.output().with_context(|| format!("could not start {cmd:?}"))?;
+    if !out.status.success() {
+        bail!("{cmd:?} failed: {}", String::from_utf8_lossy(&out.stderr).trim());
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+}

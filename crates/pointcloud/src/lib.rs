@@ -9,6 +9,7 @@
 //! * [`RangeImage`]: a `width × height` image of ranges with a [`BeamModel`] (pinhole, spherical,
 //!   or actuated laser range finder) that gives every pixel its beam direction.
 //! * [`SensorPose`]: a `world_from_sensor` rigid transform.
+//! * [`PolygonMesh`]: vertices and polygonal faces (environment meshes).
 //! * [`Aabb`]: an axis-aligned box.
 //! * [`io`]: readers and writers for PLY, PCD v0.7, OBJ, XYZ, KITTI `.bin`, 3DTK `.3d`/`.pose`
 //!   and 16-bit PNG depth images. Every reader returns a typed [`io::Error`] that names the file
@@ -26,11 +27,13 @@ pub extern crate nalgebra as na;
 mod aabb;
 mod cloud;
 pub mod io;
+mod mesh;
 mod pose;
 mod range_image;
 
 pub use aabb::Aabb;
 pub use cloud::{AttributeError, FieldData, Grid, INVALID_PIXEL, PointCloud, ScalarField};
+pub use mesh::{MeshError, PolygonMesh};
 pub use pose::SensorPose;
 pub use range_image::{
     ActuatedLrfModel, BeamModel, PinholeIntrinsics, RangeImage, RangeImageError, RangeKind,

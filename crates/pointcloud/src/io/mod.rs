@@ -230,3 +230,243 @@ pub enum Precision {
     /// 64-bit floats (exact round trip of our `f64` positions).
     F64,
 }
+
+// Path-level entry points: the format comes from the file extension.
+
+/// Reads the cloud stored in `path`, with the reader its extension names
+/// ([`Format::from_path`]):
+///
+/// | extension | reader | notes |
+/// |---|---|---|
+/// | `.ply` | [`ply::read_ply`] | |
+/// | `.pcd` | [`pcd::read_pcd`] | |
+/// | `.obj` | [`obj::read_obj`] | the mesh's vertices (faces dropped; see [`read_mesh`]) |
+/// | `.xyz`, `.txt` | [`xyz::read_xyz`] | |
+/// | `.bin` | [`kitti::read_kitti_bin`] | unorganised; all-zero records ("no return") dropped |
+/// | `.3d` | [`uos::read_uos_scan`] | every point kept (no range filter); the sibling `.pose` file, if there is one, becomes the [`crate::PointCloud::sensor_pose`] |
+/// | `.png` | [`read_range_image`] with the camera of [`depth_camera_for`] | the organised cloud in the camera's optical frame |
+///
+/// `options` applies to the unorganised readers (and to the `.bin`, `.3d` non-finite points).
+/// Every error names `path` (or the `.pose` / intrinsics file it came from); an unknown
+/// extension is [`ErrorKind::Unsupported`].
+pub fn read_cloud(path: &Path, options: &ReadOptions) -> Result<crate::PointCloud, Error> {
+    let format = format_of(path)?;
+    let open = || open_read(format, path);
+    let cloud = match format {
+        Format::Ply => ply::read_ply(open()?, options),
+        Format::Pcd => pcd::read_pcd(open()?, options),
+        Format::Obj => obj::read_obj(open()?).and_then(|mesh| {
+            crate::PointCloud::from_positions(mesh.vertices().to_vec())
+                .map_err(|e| Error::new(format, e))
+        }),
+        Format::Xyz => xyz::read_xyz(open()?, options),
+        Format::KittiBin => {
+            let o = kitti::KittiReadOptions {
+                layout: kitti::KittiLayout::Unorganized,
+                zero_is_invalid: true,
+                non_finite: *options,
+            };
+            kitti::read_kitti_bin(open()?, &o)
+        }
+        Format::Uos => {
+            let o = uos::UosReadOptions { non_finite: *options, ..Default::default() };
+            let mut cloud = uos::read_uos_scan(open()?, &o).map_err(|e| e.with_path(path))?;
+            let pose_path = path.with_extension("pose");
+            if pose_path.is_file() {
+                let pose = uos::read_uos_pose(open_read(format, &pose_path)?)
+                    .map_err(|e| e.with_path(&pose_path))?;
+                cloud.set_sensor_pose(Some(pose));
+            }
+            return Ok(cloud);
+        }
+        Format::DepthPng => {
+            return read_range_image(path, None)?.to_cloud().map_err(|e| {
+                Error::new(format, ErrorKind::BadValue(e.to_string())).with_path(path)
+            });
+        }
+    };
+    cloud.map_err(|e| e.with_path(path))
+}
+
+/// Reads the mesh of an `.obj` file (see [`obj::read_obj`]); errors name `path`.
+pub fn read_mesh(path: &Path) -> Result<crate::PolygonMesh, Error> {
+    obj::read_obj(open_read(Format::Obj, path)?).map_err(|e| e.with_path(path))
+}
+
+/// Reads a 16-bit PNG depth image with `camera`, or, with `None`, with the camera
+/// [`depth_camera_for`] finds for it. The values are z depths ([`crate::RangeKind::Depth`]);
+/// for radial-distance images use [`depth_png::read_range_png`].
+///
+/// When the camera comes from a sidecar JSON file that states `width` and `height`, they must
+/// match the image.
+pub fn read_range_image(
+    path: &Path,
+    camera: Option<&depth_png::DepthCamera>,
+) -> Result<crate::RangeImage, Error> {
+    let format = Format::DepthPng;
+    let (camera, sidecar) = match camera {
+        Some(c) => (*c, None),
+        None => find_depth_camera(path)?,
+    };
+    let image = depth_png::read_depth_png(open_read(format, path)?, &camera)
+        .map_err(|e| e.with_path(path))?;
+    if let Some((json, Some(size))) = sidecar
+        && size != (image.width(), image.height())
+    {
+        return Err(Error::new(
+            format,
+            ErrorKind::BadValue(format!(
+                "{} says the image is {}×{}, but {} is {}×{}",
+                json.display(),
+                size.0,
+                size.1,
+                path.display(),
+                image.width(),
+                image.height()
+            )),
+        )
+        .with_path(path));
+    }
+    Ok(image)
+}
+
+/// The depth camera for the PNG depth image at `path`:
+///
+/// * the intrinsics JSON file next to it (see [`depth_png::read_intrinsics_json`]) whose name is
+///   `<prefix>_intrinsics<anything>.json` where the image's file stem is `<prefix>` or starts
+///   with `<prefix>_` (so `office1_intrinsics_fitted.json` serves `office1_zdepth_mm.png`); of
+///   several, the longest prefix wins, then the first name in byte order. Its depth scale is the
+///   JSON's optional `depth_scale` key (metres per unit), else millimetres (0.001);
+/// * else [`depth_png::DepthCamera::openni_mm`] (fx = fy = 525, cx = 320, cy = 240, mm). Images
+///   in another convention (TUM RGB-D: 1/5000 m) need an explicit camera: pass
+///   [`depth_png::DepthCamera::tum_kinect`] to [`read_range_image`].
+pub fn depth_camera_for(path: &Path) -> Result<depth_png::DepthCamera, Error> {
+    Ok(find_depth_camera(path)?.0)
+}
+
+/// The sidecar JSON of a depth PNG and the image size it states, if any.
+type Sidecar = (PathBuf, Option<(u32, u32)>);
+
+fn find_depth_camera(path: &Path) -> Result<(depth_png::DepthCamera, Option<Sidecar>), Error> {
+    let format = Format::DepthPng;
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::new(format, e).with_path(dir))?;
+    let mut best: Option<(usize, String)> = None;
+    for entry in entries {
+        let entry = entry.map_err(|e| Error::new(format, e).with_path(dir))?;
+        let Some(name) = entry.file_name().to_str().map(str::to_owned) else { continue };
+        let Some(base) = name.strip_suffix(".json") else { continue };
+        let Some(at) = base.find("_intrinsics") else { continue };
+        let prefix = &base[..at];
+        let serves = stem == prefix
+            || (stem.starts_with(prefix) && stem.as_bytes().get(prefix.len()) == Some(&b'_'));
+        if !serves || !entry.path().is_file() {
+            continue;
+        }
+        let better = match &best {
+            None => true,
+            Some((len, n)) => prefix.len() > *len || (prefix.len() == *len && name < *n),
+        };
+        if better {
+            best = Some((prefix.len(), name));
+        }
+    }
+    let Some((_, name)) = best else {
+        return Ok((depth_png::DepthCamera::openni_mm(), None));
+    };
+    let json = dir.join(name);
+    let j = depth_png::parse_intrinsics_json(open_read(format, &json)?)
+        .map_err(|e| e.with_path(&json))?;
+    let camera = depth_png::DepthCamera {
+        intrinsics: crate::PinholeIntrinsics { fx: j.fx, fy: j.fy, cx: j.cx, cy: j.cy },
+        depth_scale: j.depth_scale.unwrap_or(0.001),
+    };
+    let size = j.width.zip(j.height);
+    Ok((camera, Some((json, size))))
+}
+
+/// Writes `cloud` to `path` in the format its extension names ([`Format::from_path`]):
+///
+/// | extension | writer | what is written |
+/// |---|---|---|
+/// | `.ply` | [`ply::write_ply`] | binary little-endian, `double` positions and normals ([`Precision::F64`]: the round trip is exact) |
+/// | `.pcd` | [`pcd::write_pcd`] | `binary_compressed`, `F 4` positions and normals ([`Precision::F32`], what PCL's point types expect; call [`pcd::write_pcd`] with [`Precision::F64`] for an exact round trip) |
+/// | `.obj` | [`obj::write_obj`] | the positions as vertices, no faces |
+/// | `.xyz`, `.txt` | [`xyz::write_xyz`] | positions and intensity, exact decimal text |
+/// | `.bin` | [`kitti::write_kitti_bin`] | float32 records (organised clouds column-major) |
+/// | `.3d` | [`uos::write_uos_scan`] | positions in cm in 3DTK's frame, plus the sibling `.pose` file ([`uos::write_uos_pose`]) with the sensor pose, identity when the cloud has none |
+///
+/// `.png` is refused ([`ErrorKind::Unsupported`]): a depth image needs a camera, so write a
+/// [`crate::RangeImage`] with [`depth_png::write_depth_png`]. Every error names `path`.
+pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> {
+    let format = format_of(path)?;
+    let create = || {
+        std::fs::File::create(path)
+            .map(std::io::BufWriter::new)
+            .map_err(|e| Error::new(format, e).with_path(path))
+    };
+    let result = match format {
+        Format::Ply => {
+            let o = ply::PlyWriteOptions {
+                encoding: ply::PlyEncoding::BinaryLittleEndian,
+                precision: Precision::F64,
+            };
+            ply::write_ply(create()?, cloud, &o)
+        }
+        Format::Pcd => {
+            let o = pcd::PcdWriteOptions {
+                encoding: pcd::PcdEncoding::BinaryCompressed,
+                precision: Precision::F32,
+            };
+            pcd::write_pcd(create()?, cloud, &o)
+        }
+        Format::Obj => crate::PolygonMesh::new(cloud.positions().to_vec(), Vec::new())
+            .map_err(|e| Error::new(format, ErrorKind::BadValue(e.to_string())))
+            .and_then(|mesh| obj::write_obj(create()?, &mesh)),
+        Format::Xyz => xyz::write_xyz(create()?, cloud),
+        Format::KittiBin => kitti::write_kitti_bin(create()?, cloud),
+        Format::Uos => {
+            uos::write_uos_scan(create()?, cloud).map_err(|e| e.with_path(path))?;
+            let pose_path = path.with_extension("pose");
+            let pose = cloud.sensor_pose().copied().unwrap_or_else(crate::SensorPose::identity);
+            let file = std::fs::File::create(&pose_path)
+                .map_err(|e| Error::new(format, e).with_path(&pose_path))?;
+            return uos::write_uos_pose(std::io::BufWriter::new(file), &pose)
+                .map_err(|e| e.with_path(&pose_path));
+        }
+        Format::DepthPng => Err(Error::new(
+            format,
+            ErrorKind::Unsupported(
+                "a cloud cannot be written as a PNG depth image without a camera; \
+                 write a RangeImage with depth_png::write_depth_png"
+                    .into(),
+            ),
+        )),
+    };
+    result.map_err(|e| e.with_path(path))
+}
+
+/// The format of `path`, or an [`ErrorKind::Unsupported`] error naming the extension.
+fn format_of(path: &Path) -> Result<Format, Error> {
+    Format::from_path(path).ok_or_else(|| Error {
+        // An unknown extension has no format; the error names the path and the extension.
+        format: Format::Xyz,
+        path: Some(path.to_owned()),
+        position: None,
+        kind: ErrorKind::Unsupported(format!(
+            "unknown file extension {:?} (expected ply, pcd, obj, xyz, txt, bin, 3d or png)",
+            path.extension().map(|e| e.to_string_lossy()).unwrap_or_default()
+        )),
+    })
+}
+
+/// Opens `path` for buffered reading; the error names the path.
+fn open_read(format: Format, path: &Path) -> Result<std::io::BufReader<std::fs::File>, Error> {
+    std::fs::File::open(path)
+        .map(std::io::BufReader::new)
+        .map_err(|e| Error::new(format, e).with_path(path))
+}
