@@ -156,3 +156,14 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn every_prefix_reads_or_fails_with_a_line() {
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2/2 3/3 4/4\nf -4 -3 -2\n";
+    for len in 0..=text.len() {
+        match read(&text[..len]) {
+            Ok(m) => assert!(m.num_faces() <= 2),
+            Err(e) => assert!(matches!(e.position, Some(Position::Line(_))), "{len}: {e}"),
+        }
+    }
+}

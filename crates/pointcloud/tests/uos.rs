@@ -161,3 +161,20 @@ proptest! {
         let _ = read_uos_pose(&bytes[..]);
     }
 }
+
+#[test]
+fn every_prefix_reads_or_fails_with_a_line() {
+    let text = "3 x 1\n100 0 0 7\n0 100 0 8\n0 0 100 9\n";
+    for len in 0..=text.len() {
+        match read(&text[..len]) {
+            Ok(c) => assert!(c.len() <= 3),
+            Err(e) => assert!(matches!(e.position, Some(Position::Line(_))), "{len}: {e}"),
+        }
+    }
+    let pose = "-3.1 -7.5 156.9\n1.35 -0.85 -0.56\n";
+    for len in 0..=pose.len() {
+        if let Err(e) = read_uos_pose(&pose.as_bytes()[..len]) {
+            assert!(matches!(e.position, Some(Position::Line(_))), "{len}: {e}");
+        }
+    }
+}

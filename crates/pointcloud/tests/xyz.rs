@@ -129,3 +129,14 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn every_prefix_reads_or_fails_with_a_line() {
+    let text = "# xyz\n1.5 2 3 0.25\n-4e-3, 5, 6, 1\n\n7 8 9 0\n";
+    for len in 0..=text.len() {
+        match read_xyz(&text.as_bytes()[..len], &ReadOptions::STRICT) {
+            Ok(c) => assert!(c.len() <= 3),
+            Err(e) => assert!(matches!(e.position, Some(Position::Line(_))), "{len}: {e}"),
+        }
+    }
+}

@@ -713,3 +713,230 @@ impl Shape {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+
+    fn ray(o: [Real; 3], d: [Real; 3]) -> (Point3, Vector3) {
+        (Point3::new(o[0], o[1], o[2]), Vector3::new(d[0], d[1], d[2]).normalize())
+    }
+
+    fn square_with_hole() -> PlanarPolygon {
+        // The square [0, 4]² at height z = 1 (normal +z) with the hole [1, 2]².
+        PlanarPolygon::rectangle(
+            Isometry3::translation(0.0, 0.0, 1.0),
+            Point2::new(0.0, 0.0),
+            Point2::new(4.0, 4.0),
+            &[(Point2::new(1.0, 1.0), Point2::new(2.0, 2.0))],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn polygon_hits_outside_holes_only() {
+        let p = square_with_hole();
+        let (o, d) = ray([3.0, 3.0, 5.0], [0.0, 0.0, -1.0]);
+        let h = p.intersect(&o, &d, 100.0).unwrap();
+        assert!((h.t - 4.0).abs() < 1e-12);
+        assert_eq!(h.normal, Vector3::z());
+        let (o, d) = ray([1.5, 1.5, 5.0], [0.0, 0.0, -1.0]);
+        assert!(p.intersect(&o, &d, 100.0).is_none(), "through the hole");
+        let (o, d) = ray([5.0, 3.0, 5.0], [0.0, 0.0, -1.0]);
+        assert!(p.intersect(&o, &d, 100.0).is_none(), "beside the outline");
+        // From below, slanted: two-sided.
+        let (o, d) = ray([0.0, 0.0, 0.0], [3.0, 0.5, 1.0]);
+        let h = p.intersect(&o, &d, 100.0).unwrap();
+        assert!((h.t - 10.25f64.sqrt()).abs() < 1e-12);
+        // Parallel to the plane and beyond max range.
+        let (o, d) = ray([3.0, 3.0, 1.0], [1.0, 0.0, 0.0]);
+        assert!(p.intersect(&o, &d, 100.0).is_none());
+        let (o, d) = ray([3.0, 3.0, 5.0], [0.0, 0.0, -1.0]);
+        assert!(p.intersect(&o, &d, 3.9).is_none());
+        assert!((p.area() - 15.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hole_touching_the_outline_is_a_door() {
+        // A wall 4 × 2.5 with a door 1 × 2 from the bottom edge.
+        let wall = PlanarPolygon::rectangle(
+            Isometry3::identity(),
+            Point2::new(0.0, 0.0),
+            Point2::new(4.0, 2.5),
+            &[(Point2::new(1.0, 0.0), Point2::new(2.0, 2.0))],
+        )
+        .unwrap();
+        assert!(!wall.contains_local(1.5, 1.0));
+        assert!(wall.contains_local(1.5, 2.2));
+        assert!(wall.contains_local(0.5, 1.0));
+    }
+
+    #[test]
+    fn posed_polygon_and_parallelogram() {
+        // A vertical square facing −x at x = 2: rotate the patch frame so its +z is −x.
+        let m = Isometry3::new(Vector3::new(2.0, 0.0, 0.0), Vector3::y() * -FRAC_PI_2);
+        let p = PlanarPolygon::rectangle(m, Point2::new(-1.0, -1.0), Point2::new(1.0, 1.0), &[])
+            .unwrap();
+        assert!((p.normal() - (-Vector3::x())).norm() < 1e-12);
+        let (o, d) = ray([0.0, 0.5, 0.5], [1.0, 0.0, 0.0]);
+        assert!((p.intersect(&o, &d, 10.0).unwrap().t - 2.0).abs() < 1e-12);
+        let q = PlanarPolygon::parallelogram(
+            Point3::new(0.0, 0.0, 0.0),
+            Vector3::new(2.0, 0.0, 0.0),
+            Vector3::new(1.0, 1.0, 0.0),
+        )
+        .unwrap();
+        assert!((q.normal() - Vector3::z()).norm() < 1e-12);
+        assert!((q.area() - 2.0).abs() < 1e-12);
+        let (o, d) = ray([2.9, 0.95, 1.0], [0.0, 0.0, -1.0]);
+        assert!(q.intersect(&o, &d, 10.0).is_some());
+        let (o, d) = ray([0.1, 0.95, 1.0], [0.0, 0.0, -1.0]);
+        assert!(q.intersect(&o, &d, 10.0).is_none(), "outside the slanted edge");
+    }
+
+    #[test]
+    fn bad_polygons_are_refused() {
+        let id = Isometry3::identity();
+        let pts = |v: &[(Real, Real)]| v.iter().map(|&(x, y)| Point2::new(x, y)).collect::<Vec<_>>();
+        assert_eq!(
+            PlanarPolygon::new(id, pts(&[(0.0, 0.0), (1.0, 0.0)]), vec![]),
+            Err(SceneError::TooFewVertices { ring: 0, count: 2 })
+        );
+        assert!(matches!(
+            PlanarPolygon::new(id, pts(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]), vec![]),
+            Err(SceneError::DegeneratePolygon { ring: 0, .. })
+        ));
+        assert!(matches!(
+            PlanarPolygon::new(id, pts(&[(0.0, 0.0), (1.0, 0.0), (Real::NAN, 1.0)]), vec![]),
+            Err(SceneError::NonFinite { .. })
+        ));
+        let square = pts(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]);
+        assert!(matches!(
+            PlanarPolygon::new(id, square.clone(), vec![pts(&[(0.2, 0.2), (0.5, 0.5)])]),
+            Err(SceneError::TooFewVertices { ring: 1, count: 2 })
+        ));
+        let bad = Isometry3::translation(Real::INFINITY, 0.0, 0.0);
+        assert!(matches!(PlanarPolygon::new(bad, square.clone(), vec![]), Err(SceneError::NonFinite { .. })));
+        let mut skew = Isometry3::identity();
+        skew.rotation = nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0));
+        assert!(matches!(PlanarPolygon::new(skew, square, vec![]), Err(SceneError::NonUnitRotation { .. })));
+        assert!(matches!(
+            PlanarPolygon::parallelogram(Point3::origin(), Vector3::x(), Vector3::x() * 2.0),
+            Err(SceneError::DegeneratePolygon { .. })
+        ));
+    }
+
+    #[test]
+    fn box_faces_from_outside_and_inside() {
+        let b = Cuboid::axis_aligned(Point3::new(1.0, -1.0, -1.0), Point3::new(3.0, 1.0, 1.0)).unwrap();
+        let (o, d) = ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let h = b.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!((h.t, h.part), (1.0, 0));
+        assert_eq!(h.normal, -Vector3::x());
+        let (o, d) = ray([2.0, 0.0, 5.0], [0.0, 0.0, -1.0]);
+        let h = b.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!((h.t, h.part), (4.0, 5));
+        // From inside: the face the ray leaves through.
+        let (o, d) = ray([2.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        let h = b.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!((h.t, h.part), (1.0, 3));
+        let (o, d) = ray([0.0, 2.0, 0.0], [1.0, 0.0, 0.0]);
+        assert!(b.intersect(&o, &d, 10.0).is_none());
+        // Posed: a unit cube turned 45° about z at x = 3 presents an edge at x = 3 − √2/2.
+        let c = Cuboid::standing(Point2::new(3.0, 0.0), -0.5, Vector3::repeat(1.0), FRAC_PI_4).unwrap();
+        let (o, d) = ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let h = c.intersect(&o, &d, 10.0).unwrap();
+        assert!((h.t - (3.0 - FRAC_1_SQRT_2_HALF)).abs() < 1e-12);
+        assert!(matches!(
+            Cuboid::new(Isometry3::identity(), Vector3::new(1.0, 0.0, 1.0)),
+            Err(SceneError::BadParameter { .. })
+        ));
+    }
+
+    const FRAC_1_SQRT_2_HALF: Real = std::f64::consts::SQRT_2 / 2.0;
+
+    #[test]
+    fn sphere_hits() {
+        let s = Sphere::new(Point3::new(5.0, 0.0, 0.0), 1.0).unwrap();
+        let (o, d) = ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let h = s.intersect(&o, &d, 10.0).unwrap();
+        assert!((h.t - 4.0).abs() < 1e-12);
+        assert!((h.normal + Vector3::x()).norm() < 1e-12);
+        let (o, d) = ray([5.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+        assert!((s.intersect(&o, &d, 10.0).unwrap().t - 1.0).abs() < 1e-12, "from inside");
+        let (o, d) = ray([0.0, 1.01, 0.0], [1.0, 0.0, 0.0]);
+        assert!(s.intersect(&o, &d, 10.0).is_none());
+        // Slanted: the distance to a sphere along a ray at offset y = 0.6 is 5 − 0.8.
+        let (o, d) = ray([0.0, 0.6, 0.0], [1.0, 0.0, 0.0]);
+        assert!((s.intersect(&o, &d, 10.0).unwrap().t - 4.2).abs() < 1e-12);
+        assert!(Sphere::new(Point3::origin(), 0.0).is_err());
+        assert!(Sphere::new(Point3::new(Real::NAN, 0.0, 0.0), 1.0).is_err());
+    }
+
+    #[test]
+    fn cylinder_side_and_caps() {
+        let c = Cylinder::upright(Point3::new(4.0, 0.0, 0.0), 0.5, 2.0).unwrap();
+        let (o, d) = ray([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+        let h = c.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!(h.part, 0);
+        assert!((h.t - 3.5).abs() < 1e-12);
+        assert!((h.normal + Vector3::x()).norm() < 1e-12);
+        let (o, d) = ray([4.2, 0.1, 5.0], [0.0, 0.0, -1.0]);
+        let h = c.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!(h.part, 2);
+        assert!((h.t - 3.0).abs() < 1e-12);
+        let (o, d) = ray([0.0, 0.0, 2.5], [1.0, 0.0, 0.0]);
+        assert!(c.intersect(&o, &d, 10.0).is_none(), "above the top");
+        // Slanted into the top cap from above-left: enters through the cap at (3.6, 0, 2).
+        let (o, d) = ray([2.6, 0.0, 3.0], [1.0, 0.0, -1.0]);
+        let h = c.intersect(&o, &d, 10.0).unwrap();
+        assert_eq!(h.part, 2);
+        assert!((h.t - 2f64.sqrt()).abs() < 1e-12);
+        // A lying cylinder (axis along y).
+        let m = Isometry3::new(Vector3::new(3.0, 0.0, 0.0), Vector3::x() * FRAC_PI_2);
+        let lying = Cylinder::new(m, 1.0, 2.0).unwrap();
+        let (o, d) = ray([0.0, 1.5, 0.0], [1.0, 0.0, 0.0]);
+        assert!((lying.intersect(&o, &d, 10.0).unwrap().t - 2.0).abs() < 1e-12);
+        let (o, d) = ray([3.0, 10.0, 0.5], [0.0, -1.0, 0.0]);
+        let h = lying.intersect(&o, &d, 20.0).unwrap();
+        assert!((h.t - 8.0).abs() < 1e-12);
+        let aabb = Shape::from(lying).aabb();
+        assert!((aabb.extents() - Vector3::new(2.0, 4.0, 2.0)).norm() < 1e-9);
+        assert!(Cylinder::upright(Point3::origin(), -1.0, 1.0).is_err());
+        assert!(Cylinder::upright(Point3::origin(), 1.0, 0.0).is_err());
+    }
+
+    /// A hit point nudged into the solid (against the outward normal) is inside it, nudged out
+    /// of it is not.
+    #[test]
+    fn hits_lie_on_the_solid_boundary() {
+        let shapes: Vec<Shape> = vec![
+            Cuboid::standing(Point2::new(3.0, 0.5), 0.0, Vector3::new(1.0, 2.0, 0.7), 0.4).unwrap().into(),
+            Sphere::new(Point3::new(3.0, -0.5, 0.3), 0.8).unwrap().into(),
+            Cylinder::new(
+                Isometry3::new(Vector3::new(3.0, 0.0, 0.5), Vector3::new(0.3, 0.9, 0.1)),
+                0.4,
+                0.9,
+            )
+            .unwrap()
+            .into(),
+        ];
+        let mut hits = 0;
+        for s in &shapes {
+            for i in 0..400 {
+                let a = i as Real * 0.0157;
+                let target = [3.0, (a * 7.0).sin(), 0.4 + (a * 3.0).cos()];
+                let (o, d) = ray([0.0, 0.0, 0.5], [target[0], target[1], target[2] - 0.5]);
+                let Some(h) = s.intersect(&o, &d, 20.0) else { continue };
+                hits += 1;
+                let p = o + d * h.t;
+                // Outward normal: the shape's normal faces away from the inside.
+                let n = h.normal;
+                let (inside, outside) = (p - n * 1e-6, p + n * 1e-6);
+                assert!(s.contains(&inside) && !s.contains(&outside), "{s:?} at {p}");
+            }
+        }
+        assert!(hits > 200, "{hits}");
+    }
+}

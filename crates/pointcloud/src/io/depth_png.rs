@@ -246,7 +246,7 @@ pub(crate) fn parse_intrinsics_json(reader: impl Read) -> Result<IntrinsicsJson,
         } else {
             ErrorKind::BadValue(format!("intrinsics JSON: {e}"))
         };
-        Error { format: FORMAT, path: None, position, kind }
+        Error { format: Some(FORMAT), path: None, position, kind }
     })?;
     let k = [("fx", j.fx), ("fy", j.fy), ("cx", j.cx), ("cy", j.cy)];
     for (name, v) in k {

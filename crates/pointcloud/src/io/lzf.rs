@@ -1,4 +1,5 @@
-//! LZF compression in liblzf's stream format, as used by PCD `binary_compressed` data.
+//! LZF compression in liblzf's stream format (as decoded by liblzf's `lzf_decompress`), as used
+//! by PCD `binary_compressed` data.
 //!
 //! The stream is a sequence of runs, each starting with a control byte `c`:
 //!

@@ -155,8 +155,8 @@ pub enum ErrorKind {
 /// A read or write failure, with the format and, where known, the file and the position.
 #[derive(Debug)]
 pub struct Error {
-    /// The format being read or written.
-    pub format: Format,
+    /// The format being read or written (`None` when the file's format is unknown).
+    pub format: Option<Format>,
     /// The file, when reading or writing by path.
     pub path: Option<PathBuf>,
     /// Where in the file, when known.
@@ -168,12 +168,12 @@ pub struct Error {
 impl Error {
     /// An error at a position.
     pub fn at(format: Format, position: Position, kind: impl Into<ErrorKind>) -> Error {
-        Error { format, path: None, position: Some(position), kind: kind.into() }
+        Error { format: Some(format), path: None, position: Some(position), kind: kind.into() }
     }
 
     /// An error without a position.
     pub fn new(format: Format, kind: impl Into<ErrorKind>) -> Error {
-        Error { format, path: None, position: None, kind: kind.into() }
+        Error { format: Some(format), path: None, position: None, kind: kind.into() }
     }
 
     /// The same error, naming `path`.
@@ -185,9 +185,11 @@ impl Error {
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.path {
-            Some(p) => write!(f, "{} ({})", p.display(), self.format)?,
-            None => write!(f, "{}", self.format)?,
+        match (&self.path, self.format) {
+            (Some(p), Some(format)) => write!(f, "{} ({format})", p.display())?,
+            (Some(p), None) => write!(f, "{}", p.display())?,
+            (None, Some(format)) => write!(f, "{format}")?,
+            (None, None) => write!(f, "file")?,
         }
         if let Some(pos) = self.position {
             write!(f, ", {pos}")?;
@@ -450,11 +452,17 @@ pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> 
     result.map_err(|e| e.with_path(path))
 }
 
+/// Writes `mesh` to the `.obj` file at `path` (see [`obj::write_obj`]); errors name `path`.
+pub fn write_mesh(path: &Path, mesh: &crate::PolygonMesh) -> Result<(), Error> {
+    let format = Format::Obj;
+    let file = std::fs::File::create(path).map_err(|e| Error::new(format, e).with_path(path))?;
+    obj::write_obj(std::io::BufWriter::new(file), mesh).map_err(|e| e.with_path(path))
+}
+
 /// The format of `path`, or an [`ErrorKind::Unsupported`] error naming the extension.
 fn format_of(path: &Path) -> Result<Format, Error> {
     Format::from_path(path).ok_or_else(|| Error {
-        // An unknown extension has no format; the error names the path and the extension.
-        format: Format::Xyz,
+        format: None,
         path: Some(path.to_owned()),
         position: None,
         kind: ErrorKind::Unsupported(format!(

@@ -1,5 +1,10 @@
 //! PCD v0.7 (Point Cloud Library) point clouds.
 //!
+//! Format reference: "The PCD (Point Cloud Data) file format"
+//! (<https://pointclouds.org/documentation/tutorials/pcd_file_format.html>), and PCL's
+//! `pcd_io.cpp` for what the specification leaves open (padding fields, the compressed layout,
+//! `rgb` in ASCII data).
+//!
 //! # What is read
 //! A PCD file is a text header of `KEY values` lines (`#` starts a comment line) ending with the
 //! `DATA` line, followed by the point data:
@@ -423,7 +428,8 @@ fn dimensions(raw: &RawHeader, data_line: u64) -> Result<(u64, u64, u64), Error>
         }
         _ => pixels,
     };
-    if height > 1 && (u32::try_from(width).is_err() || pixels >= u64::from(INVALID_PIXEL)) {
+    let too_large = u32::try_from(width).is_err() || u32::try_from(height).is_err();
+    if height > 1 && (too_large || pixels >= u64::from(INVALID_PIXEL)) {
         return Err(Error::at(
             Format::Pcd,
             Position::Line(width_line.max(height_line)),

@@ -1,5 +1,9 @@
 //! PLY (Stanford polygon file format) point clouds.
 //!
+//! Format reference: "The PLY Polygon File Format"
+//! (<https://paulbourke.net/dataformats/ply/>), version 1.0; the header comments are those of
+//! the project's exchange format.
+//!
 //! # What is read
 //! A PLY file is a text header followed by the data of its elements, in header order:
 //!
@@ -632,30 +636,31 @@ fn read_ascii_instance(
     let text = std::str::from_utf8(text)
         .map_err(|_| bad_value(line, "the line is not UTF-8 text".into()))?;
     let mut tokens = text.split_ascii_whitespace();
-    let mut next = |what: &str| {
+    let mut next = |name: &str| {
         tokens.next().ok_or_else(|| {
-            bad_value(line, format!("the line ends before {what} of `{}`", element.name))
+            bad_value(line, format!("the line ends before property `{name}` of `{}`", element.name))
         })
     };
+    let parse = |ty: ScalarType, token: &str, name: &str| {
+        ty.parse(token).map_err(|e| bad_value(line, format!("property `{name}`: {e}")))
+    };
     for (i, property) in element.properties.iter().enumerate() {
-        let what = format!("property `{}`", property.name);
-        let parse = |ty: ScalarType, token: &str| {
-            ty.parse(token).map_err(|e| bad_value(line, format!("{what}: {e}")))
-        };
+        let name = property.name.as_str();
         match property.kind {
             PropertyKind::Scalar(ty) => {
-                let value = parse(ty, next(&what)?)?;
+                let value = parse(ty, next(name)?, name)?;
                 if let Some(Some(column)) = columns.get_mut(i) {
                     column.push(value);
                 }
             }
             PropertyKind::List { count, item } => {
-                let len = parse(count, next(&what)?)?.as_i128();
+                let len = parse(count, next(name)?, name)?.as_i128();
                 if len < 0 {
-                    return Err(bad_value(line, format!("{what}: negative list length {len}")));
+                    let message = format!("property `{name}`: negative list length {len}");
+                    return Err(bad_value(line, message));
                 }
                 for _ in 0..len {
-                    parse(item, next(&what)?)?;
+                    parse(item, next(name)?, name)?;
                 }
             }
         }
@@ -1379,7 +1384,12 @@ pub(crate) mod common {
                 }
                 Layout::Unorganised if !finite && !options.skip_non_finite => {
                     let kind = ErrorKind::NonFinite { point: i as u64 };
-                    return Err(Error { format, path: None, position: rows.get(i), kind });
+                    return Err(Error {
+                        format: Some(format),
+                        path: None,
+                        position: rows.get(i),
+                        kind,
+                    });
                 }
                 Layout::Unorganised => {}
             }

@@ -1,0 +1,94 @@
+//! `patchnav info FILE`.
+
+use anyhow::Result;
+use pointcloud::io::{self, Format, ReadOptions};
+use pointcloud::{Aabb, PointCloud};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Prints what `file` holds.
+pub fn run(file: &Path, skip_non_finite: bool) -> Result<()> {
+    print!("{}", describe(file, skip_non_finite)?);
+    Ok(())
+}
+
+/// The text `info` prints for `file`.
+pub fn describe(file: &Path, skip_non_finite: bool) -> Result<String> {
+    let format = Format::from_path(file)
+        .ok_or_else(|| anyhow::anyhow!("{}: unknown file extension", file.display()))?;
+    let options = ReadOptions { skip_non_finite };
+    let mut out = String::new();
+    writeln!(out, "file:       {}", file.display())?;
+    writeln!(out, "format:     {format}")?;
+    if format == Format::Obj {
+        let mesh = io::read_mesh(file)?;
+        writeln!(out, "vertices:   {}", mesh.vertices().len())?;
+        writeln!(out, "faces:      {} ({} triangles)", mesh.faces().len(), mesh.num_triangles())?;
+        write_bounds(&mut out, &mesh.bounds())?;
+        return Ok(out);
+    }
+    let cloud = io::read_cloud(file, &options)?;
+    describe_cloud(&mut out, &cloud)?;
+    Ok(out)
+}
+
+fn describe_cloud(out: &mut String, cloud: &PointCloud) -> Result<()> {
+    writeln!(out, "points:     {}", cloud.len())?;
+    match cloud.grid() {
+        Some(g) => writeln!(
+            out,
+            "organised:  {} × {} ({} pixels, {} valid)",
+            g.width(),
+            g.height(),
+            g.num_pixels(),
+            g.num_valid()
+        )?,
+        None => writeln!(out, "organised:  no")?,
+    }
+    write_bounds(out, &cloud.bounds())?;
+    let mut attrs: Vec<String> = Vec::new();
+    if cloud.intensity().is_some() {
+        attrs.push("intensity".into());
+    }
+    if cloud.normals().is_some() {
+        attrs.push("normals".into());
+    }
+    if cloud.labels().is_some() {
+        attrs.push("labels".into());
+    }
+    if cloud.rings().is_some() {
+        attrs.push("rings".into());
+    }
+    attrs.extend(cloud.extra_fields().iter().map(|f| f.name.clone()));
+    let attrs = if attrs.is_empty() { "none".to_owned() } else { attrs.join(", ") };
+    writeln!(out, "attributes: {attrs}")?;
+    if let Some(pose) = cloud.sensor_pose() {
+        let t = pose.world_from_sensor.translation.vector;
+        let (r, p, y) = pose.world_from_sensor.rotation.euler_angles();
+        writeln!(
+            out,
+            "sensor:     at ({:.3}, {:.3}, {:.3}) m, roll {:.1}° pitch {:.1}° yaw {:.1}° (points in the sensor frame)",
+            t.x,
+            t.y,
+            t.z,
+            r.to_degrees(),
+            p.to_degrees(),
+            y.to_degrees()
+        )?;
+    }
+    Ok(())
+}
+
+fn write_bounds(out: &mut String, b: &Aabb) -> Result<()> {
+    if b.is_empty() {
+        writeln!(out, "bounds:     empty")?;
+    } else {
+        let e = b.extents();
+        writeln!(
+            out,
+            "bounds:     ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3}) m, size {:.3} × {:.3} × {:.3} m",
+            b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z, e.x, e.y, e.z
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,73 @@
+//! `patchnav`: the command-line face of the workspace.
+//!
+//! ```text
+//! patchnav info FILE                      what a file holds
+//! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
+//! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
+//! ```
+//!
+//! Errors are printed as one line on standard error and the exit code is 1 (2 for usage errors,
+//! as clap reports them).
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+mod convert;
+mod info;
+mod progress;
+mod simulate;
+
+/// Turns 3D range data into maps a robot can plan on.
+#[derive(Parser, Debug)]
+#[command(name = "patchnav", version, about, long_about = None)]
+struct Cli {
+    /// Print nothing but errors (no progress bars, no summaries).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print a file's format, point count, organised size, bounds and attributes.
+    Info {
+        /// A cloud, mesh or depth image (.ply .pcd .obj .xyz .txt .bin .3d .png).
+        file: PathBuf,
+        /// Drop NaN/infinite points of unorganised clouds instead of failing.
+        #[arg(long)]
+        skip_non_finite: bool,
+    },
+    /// Convert a cloud or mesh between formats (chosen by the file extensions).
+    Convert {
+        /// Input file.
+        input: PathBuf,
+        /// Output file (.ply .pcd .obj .xyz .bin .3d).
+        output: PathBuf,
+        /// Drop NaN/infinite points of unorganised clouds instead of failing.
+        #[arg(long)]
+        skip_non_finite: bool,
+    },
+    /// Scan a synthetic scene with a simulated sensor from several poses.
+    Simulate(simulate::SimulateArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let progress = progress::Progress::new(cli.quiet);
+    let result = match cli.command {
+        Command::Info { file, skip_non_finite } => info::run(&file, skip_non_finite),
+        Command::Convert { input, output, skip_non_finite } => {
+            convert::run(&input, &output, skip_non_finite, &progress)
+        }
+        Command::Simulate(args) => simulate::run(&args, &progress),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

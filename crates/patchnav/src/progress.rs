@@ -1,0 +1,47 @@
+//! Progress bars and summaries, silenced by `--quiet`.
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Where the program reports progress: bars on a terminal's standard error, nothing when quiet.
+pub struct Progress {
+    quiet: bool,
+}
+
+impl Progress {
+    /// A reporter; `quiet` silences everything but errors.
+    pub fn new(quiet: bool) -> Progress {
+        Progress { quiet }
+    }
+
+    /// A bar counting `len` steps of `what` (hidden when quiet or not on a terminal).
+    pub fn bar(&self, len: u64, what: &str) -> ProgressBar {
+        if self.quiet {
+            return ProgressBar::hidden();
+        }
+        let bar = ProgressBar::new(len);
+        let style = ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} {elapsed}")
+            .map(|s| s.progress_chars("=> "))
+            .unwrap_or_else(|_| ProgressStyle::default_bar());
+        bar.set_style(style);
+        bar.set_message(what.to_owned());
+        bar
+    }
+
+    /// A spinner for one long step.
+    pub fn spinner(&self, what: &str) -> ProgressBar {
+        if self.quiet {
+            return ProgressBar::hidden();
+        }
+        let s = ProgressBar::new_spinner();
+        s.set_message(what.to_owned());
+        s.enable_steady_tick(std::time::Duration::from_millis(120));
+        s
+    }
+
+    /// Prints a summary line on standard output unless quiet.
+    pub fn say(&self, line: impl AsRef<str>) {
+        if !self.quiet {
+            println!("{}", line.as_ref());
+        }
+    }
+}
