@@ -42,8 +42,14 @@ pub fn run(args: &[String]) -> Result<()> {
     let args = parse(args)?;
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let mut cmd = Command::new(cargo);
-    cmd.current_dir(crate::project_root())
-        .args(["run", "--quiet", "--release", "-p", "bench-matrix", "--"]);
+    cmd.current_dir(crate::project_root()).args([
+        "run",
+        "--quiet",
+        "--release",
+        "-p",
+        "bench-matrix",
+        "--",
+    ]);
     if args.list {
         cmd.arg("--list");
         print!("{}", crate::capture(&mut cmd)?);

@@ -22,8 +22,8 @@ use serde::{Deserialize, Serialize};
 /// foreground and the background.
 ///
 /// Simulated by casting a second ray offset from the beam axis by half the `divergence`, in a
-/// random direction around it: if its range differs from the main ray's by more than
-/// `min_jump`, then with probability `probability` the beam reports
+/// random direction around it: if it hits another surface and its range differs from the main
+/// ray's by more than `min_jump`, then with probability `probability` the beam reports
 /// `r_main + w·(r_second − r_main)`, `w` uniform in [0, 1]. A second ray that hits nothing
 /// within range leaves the beam alone.
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -222,6 +222,7 @@ impl RangeSensor for Alrf {
                 let d2 = hit.direction + (e1 * psi.cos() + e2 * psi.sin()) * off;
                 let dir2 = UnitVector3::new_normalize(rotation * d2);
                 if let Some(h2) = scene.cast_ray(&origin, &dir2, c.max_range)
+                    && h2.surface != hit.surface
                     && (h2.distance - r).abs() > m.min_jump
                     && rng.random_bool(m.probability)
                 {
