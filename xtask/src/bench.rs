@@ -81,12 +81,7 @@ pub fn run(args: &[String]) -> Result<()> {
 }
 
 fn summary(row: &Value) -> String {
-    let s = |k: &str| row.get(k).map(|v| v.to_string().trim_matches('"').to_owned());
-    format!(
-        "{:<10} {:<32} {:>14} {}",
-        s("bench").unwrap_or_default(),
-        s("case").unwrap_or_default(),
-        s("value").unwrap_or_default(),
-        s("unit").unwrap_or_default()
-    )
+    let s = |k: &str| row.get(k).and_then(Value::as_str).unwrap_or("?").to_owned();
+    let value = row.get("value").and_then(Value::as_f64).unwrap_or(f64::NAN);
+    format!("{:<8} {:<34} {:<14} {:>12.3} {}", s("bench"), s("case"), s("metric"), value, s("unit"))
 }

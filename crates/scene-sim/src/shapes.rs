@@ -798,7 +798,8 @@ mod tests {
     #[test]
     fn bad_polygons_are_refused() {
         let id = Isometry3::identity();
-        let pts = |v: &[(Real, Real)]| v.iter().map(|&(x, y)| Point2::new(x, y)).collect::<Vec<_>>();
+        let pts =
+            |v: &[(Real, Real)]| v.iter().map(|&(x, y)| Point2::new(x, y)).collect::<Vec<_>>();
         assert_eq!(
             PlanarPolygon::new(id, pts(&[(0.0, 0.0), (1.0, 0.0)]), vec![]),
             Err(SceneError::TooFewVertices { ring: 0, count: 2 })
@@ -817,10 +818,17 @@ mod tests {
             Err(SceneError::TooFewVertices { ring: 1, count: 2 })
         ));
         let bad = Isometry3::translation(Real::INFINITY, 0.0, 0.0);
-        assert!(matches!(PlanarPolygon::new(bad, square.clone(), vec![]), Err(SceneError::NonFinite { .. })));
+        assert!(matches!(
+            PlanarPolygon::new(bad, square.clone(), vec![]),
+            Err(SceneError::NonFinite { .. })
+        ));
         let mut skew = Isometry3::identity();
-        skew.rotation = nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0));
-        assert!(matches!(PlanarPolygon::new(skew, square, vec![]), Err(SceneError::NonUnitRotation { .. })));
+        skew.rotation =
+            nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0));
+        assert!(matches!(
+            PlanarPolygon::new(skew, square, vec![]),
+            Err(SceneError::NonUnitRotation { .. })
+        ));
         assert!(matches!(
             PlanarPolygon::parallelogram(Point3::origin(), Vector3::x(), Vector3::x() * 2.0),
             Err(SceneError::DegeneratePolygon { .. })
@@ -829,7 +837,8 @@ mod tests {
 
     #[test]
     fn box_faces_from_outside_and_inside() {
-        let b = Cuboid::axis_aligned(Point3::new(1.0, -1.0, -1.0), Point3::new(3.0, 1.0, 1.0)).unwrap();
+        let b =
+            Cuboid::axis_aligned(Point3::new(1.0, -1.0, -1.0), Point3::new(3.0, 1.0, 1.0)).unwrap();
         let (o, d) = ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         let h = b.intersect(&o, &d, 10.0).unwrap();
         assert_eq!((h.t, h.part), (1.0, 0));
@@ -844,7 +853,8 @@ mod tests {
         let (o, d) = ray([0.0, 2.0, 0.0], [1.0, 0.0, 0.0]);
         assert!(b.intersect(&o, &d, 10.0).is_none());
         // Posed: a unit cube turned 45° about z at x = 3 presents an edge at x = 3 − √2/2.
-        let c = Cuboid::standing(Point2::new(3.0, 0.0), -0.5, Vector3::repeat(1.0), FRAC_PI_4).unwrap();
+        let c =
+            Cuboid::standing(Point2::new(3.0, 0.0), -0.5, Vector3::repeat(1.0), FRAC_PI_4).unwrap();
         let (o, d) = ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
         let h = c.intersect(&o, &d, 10.0).unwrap();
         assert!((h.t - (3.0 - FRAC_1_SQRT_2_HALF)).abs() < 1e-12);
@@ -912,7 +922,9 @@ mod tests {
     #[test]
     fn hits_lie_on_the_solid_boundary() {
         let shapes: Vec<Shape> = vec![
-            Cuboid::standing(Point2::new(3.0, 0.5), 0.0, Vector3::new(1.0, 2.0, 0.7), 0.4).unwrap().into(),
+            Cuboid::standing(Point2::new(3.0, 0.5), 0.0, Vector3::new(1.0, 2.0, 0.7), 0.4)
+                .unwrap()
+                .into(),
             Sphere::new(Point3::new(3.0, -0.5, 0.3), 0.8).unwrap().into(),
             Cylinder::new(
                 Isometry3::new(Vector3::new(3.0, 0.0, 0.5), Vector3::new(0.3, 0.9, 0.1)),

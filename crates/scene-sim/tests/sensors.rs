@@ -14,12 +14,8 @@ const HI: [Real; 3] = [6.0, 5.0, 2.0];
 /// A box room seen from inside (one cuboid, six faces).
 fn box_room(material: Material) -> Scene {
     let mut b = SceneBuilder::new("box-room");
-    b.add(
-        "room",
-        Cuboid::axis_aligned(Point3::from(LO), Point3::from(HI)).unwrap(),
-        material,
-    )
-    .unwrap();
+    b.add("room", Cuboid::axis_aligned(Point3::from(LO), Point3::from(HI)).unwrap(), material)
+        .unwrap();
     b.build().unwrap()
 }
 
@@ -102,7 +98,8 @@ fn noise_free_range_camera_reports_depth() {
     }
     // The camera looks along its heading: the centre pixel's world direction.
     let centre = pose.world_from_sensor.rotation * Vector3::z();
-    let expected = Vector3::new(0.3f64.cos() * 0.2f64.cos(), 0.3f64.sin() * 0.2f64.cos(), -0.2f64.sin());
+    let expected =
+        Vector3::new(0.3f64.cos() * 0.2f64.cos(), 0.3f64.sin() * 0.2f64.cos(), -0.2f64.sin());
     assert!((centre - expected).norm() < 1e-12);
     // Hits for a ToF model extend past the camera's own range.
     let far = RangeCamera::swissranger_sr3000().scan_hits(&box_room(Material::WOOD), &pose);
@@ -114,8 +111,13 @@ fn range_window_and_dark_surfaces() {
     let cam = RangeCamera::swissranger_sr3000();
     // A 12 m deep room: the far wall is beyond 7.5 m and gives no measurement, but has truth.
     let mut b = SceneBuilder::new("deep");
-    b.add("far", Cuboid::axis_aligned(Point3::new(12.0, -20.0, -20.0), Point3::new(13.0, 20.0, 20.0)).unwrap(), Material::WOOD)
-        .unwrap();
+    b.add(
+        "far",
+        Cuboid::axis_aligned(Point3::new(12.0, -20.0, -20.0), Point3::new(13.0, 20.0, 20.0))
+            .unwrap(),
+        Material::WOOD,
+    )
+    .unwrap();
     let scene = b.build().unwrap();
     let pose = camera_pose_looking(Point3::origin(), 0.0, 0.0);
     let scan = cam.scan(&scene, &pose, 1);
@@ -144,7 +146,10 @@ fn mean_std(v: &[Real]) -> (Real, Real) {
 #[test]
 fn alrf_noise_has_the_configured_sigma() {
     let scene = box_room(Material::WHITE_MASONRY);
-    let c = AlrfConfig { mixed_pixels: None, ..AlrfConfig::sick_s300_with_step(2f64.to_radians()).unwrap() };
+    let c = AlrfConfig {
+        mixed_pixels: None,
+        ..AlrfConfig::sick_s300_with_step(2f64.to_radians()).unwrap()
+    };
     let alrf = Alrf::new(c).unwrap();
     let scan = alrf.scan(&scene, &pose(), 11);
     let errors: Vec<Real> = scan
@@ -174,7 +179,10 @@ fn stereo_noise_grows_with_depth_squared_and_texture_matters() {
         b.add(
             "plane",
             PlanarPolygon::rectangle(
-                pointcloud::Isometry3::new(Vector3::new(x, 0.0, 0.0), Vector3::y() * -std::f64::consts::FRAC_PI_2),
+                pointcloud::Isometry3::new(
+                    Vector3::new(x, 0.0, 0.0),
+                    Vector3::y() * -std::f64::consts::FRAC_PI_2,
+                ),
                 Point2::new(-50.0, -50.0),
                 Point2::new(50.0, 50.0),
                 &[],
@@ -189,7 +197,8 @@ fn stereo_noise_grows_with_depth_squared_and_texture_matters() {
     let mut sigmas = Vec::new();
     for z in [2.0, 6.0] {
         let scan = cam.scan(&plane_at(z, Material::WOOD), &pose, 5);
-        let errors: Vec<Real> = scan.image.ranges().iter().flatten().map(|&r| r as Real - z).collect();
+        let errors: Vec<Real> =
+            scan.image.ranges().iter().flatten().map(|&r| r as Real - z).collect();
         assert_eq!(errors.len(), 160 * 120);
         let (m, s) = mean_std(&errors);
         let expected = cam.depth_sigma(z);
@@ -198,7 +207,10 @@ fn stereo_noise_grows_with_depth_squared_and_texture_matters() {
         sigmas.push(s);
     }
     assert!((sigmas[1] / sigmas[0] - 9.0).abs() < 0.6, "σ ∝ z²");
-    assert!((cam.config().depth_noise_factor() - 0.1 / (cam.config().intrinsics().fx * 0.09)).abs() < 1e-15);
+    assert!(
+        (cam.config().depth_noise_factor() - 0.1 / (cam.config().intrinsics().fx * 0.09)).abs()
+            < 1e-15
+    );
     let plain = cam.scan(&plane_at(3.0, Material::WHITE_MASONRY), &pose, 5);
     let ratio = plain.valid_ratio();
     assert!((ratio - 0.05).abs() < 0.015, "textureless surfaces mostly drop out: {ratio}");
@@ -233,10 +245,18 @@ fn same_seed_same_scan_other_seed_other_noise() {
 fn mixed_pixels_lie_between_foreground_and_background() {
     // A thin post in front of a wall: beams at its edges straddle both.
     let mut b = SceneBuilder::new("post");
-    b.add("wall", Cuboid::axis_aligned(Point3::new(5.0, -10.0, -10.0), Point3::new(5.5, 10.0, 10.0)).unwrap(), Material::WOOD)
-        .unwrap();
-    b.add("post", Cuboid::axis_aligned(Point3::new(2.0, -0.1, -10.0), Point3::new(2.2, 0.1, 10.0)).unwrap(), Material::WOOD)
-        .unwrap();
+    b.add(
+        "wall",
+        Cuboid::axis_aligned(Point3::new(5.0, -10.0, -10.0), Point3::new(5.5, 10.0, 10.0)).unwrap(),
+        Material::WOOD,
+    )
+    .unwrap();
+    b.add(
+        "post",
+        Cuboid::axis_aligned(Point3::new(2.0, -0.1, -10.0), Point3::new(2.2, 0.1, 10.0)).unwrap(),
+        Material::WOOD,
+    )
+    .unwrap();
     let scene = b.build().unwrap();
     let cfg = AlrfConfig {
         range_sigma: 0.0,
@@ -244,7 +264,8 @@ fn mixed_pixels_lie_between_foreground_and_background() {
         ..AlrfConfig::sick_s300_with_step(0.5f64.to_radians()).unwrap()
     };
     let scan = Alrf::new(cfg).unwrap().scan(&scene, &SensorPose::identity(), 4);
-    let mixed: Vec<usize> = (0..scan.truth.mixed_pixel.len()).filter(|&i| scan.truth.mixed_pixel[i]).collect();
+    let mixed: Vec<usize> =
+        (0..scan.truth.mixed_pixel.len()).filter(|&i| scan.truth.mixed_pixel[i]).collect();
     assert!(!mixed.is_empty());
     // Level beams whose axis hits the post report a range between the post and the wall behind.
     let post = scene.primitive(scene_sim::PrimitiveId(1)).unwrap().first_surface.0;
@@ -271,7 +292,11 @@ fn camera_mount_and_helpers_agree() {
     assert_eq!(cam, RangeCamera::swissranger_sr3000().mount(&body));
     assert_eq!(body, Alrf::sick_s300().mount(&body));
     let looking = camera_pose_looking(Point3::new(1.0, 2.0, 0.5), 0.4, 0.0);
-    assert!((looking.world_from_sensor.to_homogeneous() - cam.world_from_sensor.to_homogeneous()).norm() < 1e-12);
+    assert!(
+        (looking.world_from_sensor.to_homogeneous() - cam.world_from_sensor.to_homogeneous())
+            .norm()
+            < 1e-12
+    );
     // Optical axes: forward = body x, right = body −y, down = −z.
     let r = cam.world_from_sensor.rotation;
     assert!((r * Vector3::z() - body.world_from_sensor.rotation * Vector3::x()).norm() < 1e-12);
@@ -281,13 +306,29 @@ fn camera_mount_and_helpers_agree() {
 #[test]
 fn bad_configurations_are_refused() {
     let ok = AlrfConfig::sick_s300();
-    assert!(matches!(Alrf::new(AlrfConfig { columns: 0, ..ok }), Err(SensorError::ImageSize { .. })));
-    assert!(matches!(Alrf::new(AlrfConfig { rows: 100_000, columns: 100_000, ..ok }), Err(SensorError::ImageSize { .. })));
-    assert!(matches!(Alrf::new(AlrfConfig { range_sigma: -1.0, ..ok }), Err(SensorError::BadParameter { .. })));
-    assert!(matches!(Alrf::new(AlrfConfig { max_range: Real::NAN, ..ok }), Err(SensorError::BadParameter { .. })));
+    assert!(matches!(
+        Alrf::new(AlrfConfig { columns: 0, ..ok }),
+        Err(SensorError::ImageSize { .. })
+    ));
+    assert!(matches!(
+        Alrf::new(AlrfConfig { rows: 100_000, columns: 100_000, ..ok }),
+        Err(SensorError::ImageSize { .. })
+    ));
+    assert!(matches!(
+        Alrf::new(AlrfConfig { range_sigma: -1.0, ..ok }),
+        Err(SensorError::BadParameter { .. })
+    ));
+    assert!(matches!(
+        Alrf::new(AlrfConfig { max_range: Real::NAN, ..ok }),
+        Err(SensorError::BadParameter { .. })
+    ));
     assert!(matches!(
         Alrf::new(AlrfConfig {
-            mixed_pixels: Some(MixedPixelConfig { divergence: 0.01, probability: 1.5, min_jump: 0.1 }),
+            mixed_pixels: Some(MixedPixelConfig {
+                divergence: 0.01,
+                probability: 1.5,
+                min_jump: 0.1
+            }),
             ..ok
         }),
         Err(SensorError::BadParameter { .. })

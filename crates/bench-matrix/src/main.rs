@@ -1,0 +1,187 @@
+//! Named benchmarks, one JSON object per measurement on standard output.
+//!
+//! Run them through `cargo xtask bench [NAME ...]`, which builds this program in release mode and
+//! appends every row, with the provenance of the run, to `target/bench/results.jsonl`. Each row
+//! has `bench`, `case`, `metric`, `value`, `unit`, plus benchmark-specific keys. Timings are the
+//! median of several repetitions measured in this one process, so rows of one run can be
+//! compared with each other (ratios), not with rows of another machine.
+//!
+//! Criterion benches (`cargo bench -p scene-sim`) give the statistically careful figures for the
+//! same operations; these rows are the matrix's raw material.
+
+use anyhow::{Context, Result, bail};
+use pointcloud::io::Precision;
+use pointcloud::io::pcd::{PcdEncoding, PcdWriteOptions, read_pcd, write_pcd};
+use pointcloud::io::ply::{PlyEncoding, PlyWriteOptions, read_ply, write_ply};
+use pointcloud::io::{ReadOptions, xyz};
+use scene_sim::{Alrf, RangeCamera, RangeSensor, StereoCamera, scene_by_name};
+use serde_json::{Value, json};
+use std::time::Instant;
+
+/// A named benchmark: a function of the seed giving result rows.
+struct Bench {
+    name: &'static str,
+    about: &'static str,
+    run: fn(u64) -> Result<Vec<Value>>,
+}
+
+const BENCHES: &[Bench] = &[
+    Bench {
+        name: "raycast",
+        about: "simulated scans of the lab: full ALRF (195,301 beams), range camera, stereo camera",
+        run: raycast,
+    },
+    Bench {
+        name: "io",
+        about: "write and read a full ALRF scan in PLY (binary, ascii), PCD (binary, compressed), XYZ",
+        run: io,
+    },
+];
+
+fn main() {
+    if let Err(e) = try_main() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn try_main() -> Result<()> {
+    let mut seed = 0u64;
+    let mut names = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--list" => {
+                for b in BENCHES {
+                    println!("{:<10} {}", b.name, b.about);
+                }
+                return Ok(());
+            }
+            "--seed" => {
+                let v = args.next().context("--seed needs a value")?;
+                seed = v.parse().with_context(|| format!("bad --seed `{v}`"))?;
+            }
+            _ => names.push(a),
+        }
+    }
+    for n in &names {
+        if !BENCHES.iter().any(|b| b.name == n) {
+            let known: Vec<_> = BENCHES.iter().map(|b| b.name).collect();
+            bail!("unknown benchmark `{n}`; known: {}", known.join(", "));
+        }
+    }
+    for b in BENCHES.iter().filter(|b| names.is_empty() || names.iter().any(|n| n == b.name)) {
+        for mut row in (b.run)(seed).with_context(|| format!("benchmark `{}`", b.name))? {
+            if let Some(obj) = row.as_object_mut() {
+                obj.insert("bench".into(), b.name.into());
+                obj.insert("tool".into(), concat!("patchnav-", env!("CARGO_PKG_VERSION")).into());
+            }
+            println!("{row}");
+        }
+    }
+    Ok(())
+}
+
+/// The median wall time of `repeats` calls of `f`, in seconds.
+fn median_seconds(repeats: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
+    let mut times = Vec::with_capacity(repeats);
+    for _ in 0..repeats {
+        let t = Instant::now();
+        f()?;
+        times.push(t.elapsed().as_secs_f64());
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
+}
+
+fn raycast(seed: u64) -> Result<Vec<Value>> {
+    let lab = scene_by_name("lab", seed)?;
+    let body = *lab.scan_poses(1, 0.6, seed).first().context("no pose in the lab")?;
+    let sensors: [(&str, Box<dyn RangeSensor>); 3] = [
+        ("lab/alrf-s300", Box::new(Alrf::sick_s300())),
+        ("lab/tof-sr3000", Box::new(RangeCamera::swissranger_sr3000())),
+        ("lab/stereo-stoc", Box::new(StereoCamera::stoc())),
+    ];
+    let mut rows = Vec::new();
+    for (case, sensor) in &sensors {
+        let pose = sensor.mount(&body);
+        let pixels = sensor.scan(&lab, &pose, seed).image.ranges().len();
+        let secs = median_seconds(5, || {
+            let scan = sensor.scan(&lab, &pose, seed);
+            std::hint::black_box(scan);
+            Ok(())
+        })?;
+        rows.push(json!({
+            "case": case, "metric": "time_per_scan", "value": secs * 1e3, "unit": "ms",
+            "beams": pixels, "beams_per_s": pixels as f64 / secs, "repeats": 5, "seed": seed,
+        }));
+    }
+    Ok(rows)
+}
+
+fn io(seed: u64) -> Result<Vec<Value>> {
+    let lab = scene_by_name("lab", seed)?;
+    let body = *lab.scan_poses(1, 0.6, seed).first().context("no pose in the lab")?;
+    let alrf = Alrf::sick_s300();
+    let cloud = alrf.scan(&lab, &alrf.mount(&body), seed).to_cloud()?;
+    let strict = ReadOptions::STRICT;
+    type Writer = Box<dyn Fn(&mut Vec<u8>) -> Result<()>>;
+    type Reader = fn(&[u8], &ReadOptions) -> Result<usize>;
+    let ply = |encoding| {
+        let cloud = cloud.clone();
+        let w: Writer = Box::new(move |buf: &mut Vec<u8>| {
+            let o = PlyWriteOptions { encoding, precision: Precision::F32 };
+            Ok(write_ply(buf, &cloud, &o)?)
+        });
+        w
+    };
+    let pcd = |encoding| {
+        let cloud = cloud.clone();
+        let w: Writer = Box::new(move |buf: &mut Vec<u8>| {
+            let o = PcdWriteOptions { encoding, precision: Precision::F32 };
+            Ok(write_pcd(buf, &cloud, &o)?)
+        });
+        w
+    };
+    let xyz_cloud = cloud.clone();
+    let read_ply_len: Reader = |b, o| Ok(read_ply(b, o)?.len());
+    let read_pcd_len: Reader = |b, o| Ok(read_pcd(b, o)?.len());
+    let read_xyz_len: Reader = |b, o| Ok(xyz::read_xyz(b, o)?.len());
+    let cases: Vec<(&str, Writer, Reader)> = vec![
+        ("ply-binary-le", ply(PlyEncoding::BinaryLittleEndian), read_ply_len),
+        ("ply-ascii", ply(PlyEncoding::Ascii), read_ply_len),
+        ("pcd-binary", pcd(PcdEncoding::Binary), read_pcd_len),
+        ("pcd-binary-compressed", pcd(PcdEncoding::BinaryCompressed), read_pcd_len),
+        (
+            "xyz",
+            Box::new(move |buf: &mut Vec<u8>| Ok(xyz::write_xyz(buf, &xyz_cloud)?)),
+            read_xyz_len,
+        ),
+    ];
+    let mut rows = Vec::new();
+    for (case, write, read) in &cases {
+        let mut bytes = Vec::new();
+        write(&mut bytes)?;
+        let write_s = median_seconds(3, || {
+            let mut buf = Vec::with_capacity(bytes.len());
+            write(&mut buf)
+        })?;
+        let mut read_points = 0;
+        let read_s = median_seconds(3, || {
+            read_points = read(&bytes, &strict)?;
+            Ok(())
+        })?;
+        if read_points != cloud.len() {
+            bail!("{case}: read {read_points} points, wrote {}", cloud.len());
+        }
+        let mb = bytes.len() as f64 / 1e6;
+        for (metric, secs) in [("write", write_s), ("read", read_s)] {
+            rows.push(json!({
+                "case": format!("alrf-scan/{case}"), "metric": metric, "value": secs * 1e3,
+                "unit": "ms", "points": cloud.len(), "bytes": bytes.len(),
+                "mb_per_s": mb / secs, "repeats": 3, "seed": seed,
+            }));
+        }
+    }
+    Ok(rows)
+}
