@@ -86,4 +86,12 @@ pub enum SensorError {
         /// The allowed range, in words.
         allowed: &'static str,
     },
+    /// `sensor_by_name` does not know the name.
+    #[error("unknown sensor `{name}` (known: {known})")]
+    UnknownSensor {
+        /// The name asked for.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
 }

@@ -55,7 +55,8 @@ pub use scene::{
 pub use sensors::{
     Alrf, AlrfConfig, BeamHit, GroundTruth, HitImage, MixedPixelConfig, RangeCamera,
     RangeCameraConfig, RangeSensor, SimulatedScan, StereoCamera, StereoCameraConfig,
-    camera_pose_from_body, camera_pose_looking, scan_many, trace_image,
+    camera_pose_from_body, camera_pose_looking, scan_many, sensor_by_name, sensor_names,
+    trace_image,
 };
 pub use shapes::{Cuboid, Cylinder, PlanarPolygon, Point2, Shape, Sphere};
 

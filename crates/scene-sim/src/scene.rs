@@ -185,7 +185,8 @@ impl SceneBuilder {
 ///
 /// # Performance
 /// [`Scene::cast_ray`] walks a binned-SAH bounding volume hierarchy without allocating; on the
-/// lab scene (about 100 primitives) a ray costs around a microsecond in release builds.
+/// lab scene (41 primitives, 179 surfaces) a ray costs about 0.2 µs in release builds (a full
+/// 195,301-beam laser scan in about 40 ms).
 #[derive(Clone, Debug)]
 pub struct Scene {
     name: String,

@@ -353,3 +353,15 @@ fn non_finite_pose_gives_an_empty_scan() {
     let scan = noise_free_alrf(10.0).scan(&scene, &pose, 1);
     assert_eq!(scan.image.num_valid(), 0);
 }
+
+#[test]
+fn sensors_by_name() {
+    for name in scene_sim::sensor_names() {
+        assert!(scene_sim::sensor_by_name(name).is_ok(), "{name}");
+    }
+    assert!(matches!(scene_sim::sensor_by_name("sonar"), Err(SensorError::UnknownSensor { .. })));
+    let scene = box_room(Material::WOOD);
+    let s = scene_sim::sensor_by_name("alrf-5deg").unwrap();
+    let scan = s.scan(&scene, &s.mount(&SensorPose::identity()), 1);
+    assert_eq!((scan.image.width(), scan.image.height()), (55, 37));
+}

@@ -270,6 +270,39 @@ pub fn scan_many<S: RangeSensor + ?Sized>(
         .collect()
 }
 
+const SENSOR_NAMES: &[&str] = &["alrf", "alrf-1deg", "alrf-2deg", "alrf-5deg", "sr3000", "stoc"];
+
+/// The names [`sensor_by_name`] knows.
+pub fn sensor_names() -> &'static [&'static str] {
+    SENSOR_NAMES
+}
+
+/// A preset sensor by name, for the command line:
+///
+/// | name | sensor |
+/// |---|---|
+/// | `alrf` | [`Alrf::sick_s300`], 541 × 361 beams (0.5° steps) |
+/// | `alrf-1deg`, `alrf-2deg`, `alrf-5deg` | [`AlrfConfig::sick_s300_with_step`] at 1°, 2°, 5° |
+/// | `sr3000` | [`RangeCamera::swissranger_sr3000`] |
+/// | `stoc` | [`StereoCamera::stoc`] |
+pub fn sensor_by_name(name: &str) -> Result<Box<dyn RangeSensor + Send + Sync>, SensorError> {
+    let alrf_step = |deg: Real| -> Result<Box<dyn RangeSensor + Send + Sync>, SensorError> {
+        Ok(Box::new(Alrf::new(AlrfConfig::sick_s300_with_step(deg.to_radians())?)?))
+    };
+    match name {
+        "alrf" => Ok(Box::new(Alrf::sick_s300())),
+        "alrf-1deg" => alrf_step(1.0),
+        "alrf-2deg" => alrf_step(2.0),
+        "alrf-5deg" => alrf_step(5.0),
+        "sr3000" => Ok(Box::new(RangeCamera::swissranger_sr3000())),
+        "stoc" => Ok(Box::new(StereoCamera::stoc())),
+        _ => Err(SensorError::UnknownSensor {
+            name: name.to_owned(),
+            known: SENSOR_NAMES.join(", "),
+        }),
+    }
+}
+
 /// A well-mixed seed for item `index` of a run seeded with `seed` (SplitMix64 finaliser).
 pub fn derive_seed(seed: u64, index: u64) -> u64 {
     let mut z = seed ^ index.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);

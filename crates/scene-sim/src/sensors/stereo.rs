@@ -128,8 +128,9 @@ impl RangeSensor for StereoCamera {
     fn scan(&self, scene: &Scene, pose: &SensorPose, seed: u64) -> SimulatedScan {
         let c = &self.config;
         let beams = self.beam_model();
-        // Cast a little past the depth limit: a pixel's radial range exceeds its depth.
-        let reach = c.max_range / (c.fov_x / 2.0).cos().min((c.fov_y / 2.0).cos()).max(0.1) * 1.5;
+        // A corner pixel's radial range is its depth times the length of its pinhole ray.
+        let corner = ((c.fov_x / 2.0).tan().powi(2) + (c.fov_y / 2.0).tan().powi(2) + 1.0).sqrt();
+        let reach = c.max_range * corner + 1.0;
         let hits = trace_image(scene, pose, &beams, c.width, c.height, reach);
         let k = c.depth_noise_factor();
         let n = hits.hits.len();

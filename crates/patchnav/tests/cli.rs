@@ -1,0 +1,171 @@
+//! The command line as a user meets it: real processes, real files, exit codes and messages.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn patchnav(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
+}
+
+fn fixture(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
+    p.to_str().unwrap().to_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Asserts a failure reported as one `error:` line and exit code 1.
+fn assert_one_line_error(o: &Output, needle: &str) {
+    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
+    let err = stderr(o);
+    assert_eq!(err.lines().count(), 1, "one line expected, got: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    assert!(err.contains(needle), "`{needle}` not in: {err}");
+}
+
+#[test]
+fn info_describes_every_fixture_format() {
+    let o = patchnav(&["info", &fixture("lab-alrf-2deg.ply")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("format:     PLY"), "{text}");
+    assert!(text.contains("organised:  136 × 91 (12376 pixels"), "{text}");
+    assert!(text.contains("attributes: labels"), "{text}");
+    assert!(text.contains("sensor:     at"), "{text}");
+
+    let pcd = stdout(&patchnav(&["info", &fixture("lab-tof.pcd")]));
+    let png = stdout(&patchnav(&["info", &fixture("lab-tof-depth.png")]));
+    assert!(pcd.contains("organised:  176 × 144"), "{pcd}");
+    assert!(png.contains("organised:  176 × 144"), "{png}");
+    let points = |t: &str| t.lines().find(|l| l.starts_with("points:")).unwrap().to_owned();
+    assert_eq!(points(&pcd), points(&png), "the PCD and PNG fixtures are one frame");
+
+    for name in ["terrain-ramp-stereo.bin", "lab-alrf-2deg.3d"] {
+        let o = patchnav(&["info", &fixture(name)]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        assert!(stdout(&o).contains("points:"), "{name}");
+    }
+}
+
+#[test]
+fn convert_round_trips_through_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let pcd = dir.path().join("scan.pcd");
+    let xyz = dir.path().join("scan.xyz");
+    let back = dir.path().join("back.ply");
+    let src = fixture("lab-alrf-2deg.ply");
+    for (from, to) in [(src.as_str(), &pcd), (pcd.to_str().unwrap(), &xyz)] {
+        let o = patchnav(&["--quiet", "convert", from, to.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stdout(&o).is_empty(), "--quiet prints nothing");
+    }
+    let o = patchnav(&["convert", xyz.to_str().unwrap(), back.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let points = |p: &str| {
+        stdout(&patchnav(&["info", p]))
+            .lines()
+            .find(|l| l.starts_with("points:"))
+            .unwrap()
+            .to_owned()
+    };
+    assert_eq!(points(&src), points(back.to_str().unwrap()));
+    assert_eq!(points(&src), points(pcd.to_str().unwrap()));
+}
+
+#[test]
+fn simulate_writes_scans_poses_and_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lab");
+    let o = patchnav(&[
+        "simulate",
+        "lab",
+        "--sensor",
+        "alrf",
+        "--poses",
+        "2",
+        "--step-deg",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("wrote 2 scans of `lab`"), "{}", stdout(&o));
+    for f in ["scan000.ply", "scan001.ply", "scan000_truth.ply", "poses.json", "scene.json"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let info = stdout(&patchnav(&["info", out.join("scan001.ply").to_str().unwrap()]));
+    assert!(info.contains("organised:  55 × 37"), "{info}");
+    let truth = stdout(&patchnav(&["info", out.join("scan001_truth.ply").to_str().unwrap()]));
+    assert!(truth.contains("true_range"), "{truth}");
+    let poses: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("poses.json")).unwrap()).unwrap();
+    assert_eq!(poses["scans"].as_array().unwrap().len(), 2);
+    let scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("scene.json")).unwrap()).unwrap();
+    assert!(scene["surfaces"].as_array().unwrap().len() > 10);
+}
+
+#[test]
+fn simulate_is_deterministic_for_a_seed() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, seed: &str| -> PathBuf {
+        let out = dir.path().join(name);
+        let o = patchnav(&[
+            "-q",
+            "simulate",
+            "terrain-ramp",
+            "--sensor",
+            "tof",
+            "--poses",
+            "1",
+            "--seed",
+            seed,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        out.join("scan000.ply")
+    };
+    let a = std::fs::read(run("a", "3")).unwrap();
+    let b = std::fs::read(run("b", "3")).unwrap();
+    let c = std::fs::read(run("c", "4")).unwrap();
+    assert_eq!(a, b);
+    assert_ne!(a, c);
+}
+
+#[test]
+fn errors_are_one_line_with_exit_code_one() {
+    assert_one_line_error(&patchnav(&["info", "no/such/file.ply"]), "no/such/file.ply");
+    assert_one_line_error(&patchnav(&["info", "file.unknown"]), "extension");
+
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(fixture("lab-alrf-2deg.ply")).unwrap();
+    let cut = dir.path().join("cut.ply");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    assert_one_line_error(&patchnav(&["info", cut.to_str().unwrap()]), "cut.ply");
+
+    let out = dir.path().join("x");
+    let out = out.to_str().unwrap();
+    assert_one_line_error(
+        &patchnav(&["simulate", "moon", "--sensor", "alrf", "--out", out]),
+        "unknown scene `moon`",
+    );
+    assert_one_line_error(
+        &patchnav(&["simulate", "lab", "--sensor", "alrf", "--poses", "0", "--out", out]),
+        "--poses",
+    );
+    assert_one_line_error(
+        &patchnav(&["simulate", "lab", "--sensor", "tof", "--step-deg", "1", "--out", out]),
+        "--step-deg",
+    );
+    assert_one_line_error(
+        &patchnav(&["simulate", "lab", "--sensor", "alrf", "--step-deg=-3", "--out", out]),
+        "--step-deg",
+    );
+}
