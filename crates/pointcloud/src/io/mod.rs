@@ -198,15 +198,9 @@ impl fmt::Display for Error {
     }
 }
 
-impl std::error::Error for Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match &self.kind {
-            ErrorKind::Io(e) => Some(e),
-            ErrorKind::Attribute(e) => Some(e),
-            _ => None,
-        }
-    }
-}
+/// The message already contains the underlying cause ([`ErrorKind`]), so `source` is empty: a
+/// chain printer (such as `anyhow`'s `{:#}`) shows it once.
+impl std::error::Error for Error {}
 
 /// Options shared by the cloud readers.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
