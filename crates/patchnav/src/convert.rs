@@ -1,13 +1,14 @@
 //! `patchnav convert IN OUT`.
 
+use crate::input::InputArgs;
 use crate::progress::Progress;
 use anyhow::{Result, bail};
-use pointcloud::io::{self, Format, ReadOptions};
+use pointcloud::io::{self, Format};
 use std::path::Path;
 
 /// Converts `input` to `output`, formats chosen by extension. A mesh stays a mesh when both
 /// sides are OBJ; otherwise the data travel as a point cloud (an OBJ input gives its vertices).
-pub fn run(input: &Path, output: &Path, skip_non_finite: bool, progress: &Progress) -> Result<()> {
+pub fn run(input: &Path, output: &Path, options: &InputArgs, progress: &Progress) -> Result<()> {
     let in_format = Format::from_path(input)
         .ok_or_else(|| anyhow::anyhow!("{}: unknown input extension", input.display()))?;
     let out_format = Format::from_path(output)
@@ -28,7 +29,7 @@ pub fn run(input: &Path, output: &Path, skip_non_finite: bool, progress: &Progre
         ));
         return Ok(());
     }
-    let cloud = io::read_cloud(input, &ReadOptions { skip_non_finite })?;
+    let cloud = crate::input::read_cloud(input, options)?;
     io::write_cloud(output, &cloud)?;
     spinner.finish_and_clear();
     progress.say(format!("wrote {} ({} points, {out_format})", output.display(), cloud.len()));

@@ -1,22 +1,22 @@
 //! `patchnav info FILE`.
 
+use crate::input::InputArgs;
 use anyhow::Result;
-use pointcloud::io::{self, Format, ReadOptions};
+use pointcloud::io::{self, Format};
 use pointcloud::{Aabb, PointCloud};
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// Prints what `file` holds.
-pub fn run(file: &Path, skip_non_finite: bool) -> Result<()> {
-    print!("{}", describe(file, skip_non_finite)?);
+pub fn run(file: &Path, input: &InputArgs) -> Result<()> {
+    print!("{}", describe(file, input)?);
     Ok(())
 }
 
 /// The text `info` prints for `file`.
-pub fn describe(file: &Path, skip_non_finite: bool) -> Result<String> {
+pub fn describe(file: &Path, input: &InputArgs) -> Result<String> {
     let format = Format::from_path(file)
         .ok_or_else(|| anyhow::anyhow!("{}: unknown file extension", file.display()))?;
-    let options = ReadOptions { skip_non_finite };
     let mut out = String::new();
     writeln!(out, "file:       {}", file.display())?;
     writeln!(out, "format:     {format}")?;
@@ -27,7 +27,7 @@ pub fn describe(file: &Path, skip_non_finite: bool) -> Result<String> {
         write_bounds(&mut out, &mesh.bounds())?;
         return Ok(out);
     }
-    let cloud = io::read_cloud(file, &options)?;
+    let cloud = crate::input::read_cloud(file, input)?;
     describe_cloud(&mut out, &cloud)?;
     Ok(out)
 }

@@ -15,6 +15,7 @@ use std::process::ExitCode;
 
 mod convert;
 mod info;
+mod input;
 mod progress;
 mod simulate;
 
@@ -35,9 +36,8 @@ enum Command {
     Info {
         /// A cloud, mesh or depth image (.ply .pcd .obj .xyz .txt .bin .3d .png).
         file: PathBuf,
-        /// Drop NaN/infinite points of unorganised clouds instead of failing.
-        #[arg(long)]
-        skip_non_finite: bool,
+        #[command(flatten)]
+        input: input::InputArgs,
     },
     /// Convert a cloud or mesh between formats (chosen by the file extensions).
     Convert {
@@ -45,9 +45,8 @@ enum Command {
         input: PathBuf,
         /// Output file (.ply .pcd .obj .xyz .bin .3d).
         output: PathBuf,
-        /// Drop NaN/infinite points of unorganised clouds instead of failing.
-        #[arg(long)]
-        skip_non_finite: bool,
+        #[command(flatten)]
+        options: input::InputArgs,
     },
     /// Scan a synthetic scene with a simulated sensor from several poses.
     Simulate(simulate::SimulateArgs),
@@ -57,9 +56,9 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let progress = progress::Progress::new(cli.quiet);
     let result = match cli.command {
-        Command::Info { file, skip_non_finite } => info::run(&file, skip_non_finite),
-        Command::Convert { input, output, skip_non_finite } => {
-            convert::run(&input, &output, skip_non_finite, &progress)
+        Command::Info { file, input } => info::run(&file, &input),
+        Command::Convert { input, output, options } => {
+            convert::run(&input, &output, &options, &progress)
         }
         Command::Simulate(args) => simulate::run(&args, &progress),
     };

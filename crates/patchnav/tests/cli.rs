@@ -54,6 +54,30 @@ fn info_describes_every_fixture_format() {
 }
 
 #[test]
+fn depth_camera_choice_scales_png_depth() {
+    let png = fixture("lab-tof-depth.png");
+    let far = |args: &[&str]| -> f64 {
+        let o = patchnav(args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = stdout(&o);
+        let line = text.lines().find(|l| l.starts_with("bounds:")).unwrap().to_owned();
+        // "bounds:     (x, y, z) .. (x, y, z) m, ...": the far z of the box.
+        let max = line.split("..").nth(1).unwrap();
+        let inside = &max[max.find('(').unwrap() + 1..max.find(')').unwrap()];
+        inside.split(',').nth(2).unwrap().trim().parse().unwrap()
+    };
+    let sidecar = far(&["info", &png]);
+    let openni = far(&["info", &png, "--depth-camera", "openni"]);
+    let tum = far(&["info", &png, "--depth-camera", "tum"]);
+    assert!((sidecar - openni).abs() < 1e-3, "the sidecar says millimetres: {sidecar} vs {openni}");
+    assert!((tum * 5.0 - openni).abs() < 1e-2, "TUM is 1/5000 m per unit: {tum} vs {openni}");
+    assert_one_line_error(
+        &patchnav(&["info", &fixture("lab-tof.pcd"), "--depth-camera", "tum"]),
+        "--depth-camera",
+    );
+}
+
+#[test]
 fn convert_round_trips_through_formats() {
     let dir = tempfile::tempdir().unwrap();
     let pcd = dir.path().join("scan.pcd");

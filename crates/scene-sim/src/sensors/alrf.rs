@@ -97,11 +97,11 @@ impl AlrfConfig {
     /// fast tests). The grid stays centred; `step` must be in [0.1°, 90°].
     pub fn sick_s300_with_step(step: Real) -> Result<AlrfConfig, SensorError> {
         check_range(
-            "ALRF angular step",
+            "ALRF angular step (radians)",
             step,
             0.1f64.to_radians(),
             90f64.to_radians(),
-            "[0.1°, 90°]",
+            "[0.001745, 1.5708] (0.1° to 90°)",
         )?;
         let mut c = AlrfConfig::sick_s300();
         let beam_span = c.beam_end - c.beam_start;
