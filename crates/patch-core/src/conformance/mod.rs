@@ -20,7 +20,7 @@
 //! [dev-dependencies]
 //! patch-core = { workspace = true, features = ["conformance"] }
 //! ```
-//! ```ignore
+//! ```text
 //! // tests/conformance.rs
 //! use patch_core::Tolerance;
 //! use patch_core::conformance::{SceneKind, SuiteConfig};
