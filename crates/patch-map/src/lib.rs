@@ -1,12 +1,80 @@
-//! Patch map backends (thesis §5.4.2).
+//! Patch map backends (thesis §5.4.2): the maps that answer the collision queries of
+//! `patch-core`'s capability traits (§5.4.1), and the files they are stored in.
 //!
-//! This crate is being built up; it currently holds the spatial index of the 6D bounding-box
-//! backend ([`kdtree`]), the point-cloud map ([`point_cloud`], the thesis's Algorithm 10), the
-//! triangulation of planar patches ([`triangulate`]) and the map file container ([`mapfile`]).
+//! # Backends
+//! Every backend follows the thesis's split (L5422–5428): a cheap broad phase picks candidate
+//! patches, an exact narrow phase decides on them. The narrow phase of the native backends is
+//! `patch-core`'s [`geometry`](patch_core::geometry) kernels, the same as the reference
+//! [`BruteForceMap`](patch_core::BruteForceMap), so their answers match it exactly.
+//!
+//! * [`PolygonMap`] — the thesis's SimplePatchMap (L5489–5499): a list of patches, no broad
+//!   phase (a per-patch box test inside the loop), exact kernels. The simplest correct map.
+//! * [`BBox6dMap`] — the thesis's BoundingBox6DPatchMap (L5501–5554, "a variant of sweep and
+//!   prune"): each patch's box as a point in a 6D k-d forest ([`kdtree`]), one orthogonal range
+//!   query per check, exact kernels on the candidates.
+//! * `TrimeshMap` — the role of the thesis's BulletPatchMap (L5572–5582): planar patches
+//!   triangulated ([`triangulate`]) into one parry triangle mesh with a BVH. *Being added in
+//!   parallel (module `trimesh`).*
+//! * `RapierMap` — one collider per patch in a rapier query pipeline (a dynamic broad phase).
+//!   *Being added in parallel (module `rapier`).*
+//! * [`PointCloudMap`] — the thesis's PointCloudMap (L5584–5784): no patches at all; the scan
+//!   points in k-d trees and Algorithm 10 for capsule steps ([`point_cloud`]).
+//!
+//! # Capabilities
+//! Checked at compile time by `tests/capabilities.rs`; the tolerance is the one each backend's
+//! conformance suite runs with (`tests/conformance.rs`, against the reference map):
+//!
+//! | backend | map | add | proximity | line unspec. | line spec. | capsule unspec. | capsule spec. | tolerance |
+//! |---|---|---|---|---|---|---|---|---|
+//! | [`PolygonMap`] | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | exact |
+//! | [`BBox6dMap`] | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | exact |
+//! | `TrimeshMap` *(in progress)* | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | approximate (parry's f64 tolerances) |
+//! | `RapierMap` *(in progress)* | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | ✓ | approximate (parry's f64 tolerances) |
+//! | [`PointCloudMap`] | – | points | – | ✓ | – | ✓ | – | exact against the points; against surfaces only if sampled denser than the radius |
+//!
+//! "map" is [`PatchMap`](patch_core::PatchMap) and [`FromPatches`](patch_core::FromPatches),
+//! "add" [`PatchMapMut`](patch_core::PatchMapMut), "proximity"
+//! [`ProximityQuery`](patch_core::ProximityQuery), "unspec."
+//! [`UnspecificStepIntersector`](patch_core::UnspecificStepIntersector), "spec."
+//! [`SpecificStepIntersector`](patch_core::SpecificStepIntersector), for [`LineStep`](patch_core::LineStep) and
+//! [`CapsuleStep`](patch_core::CapsuleStep). The point-cloud map has only the unspecific step
+//! queries, as the thesis scopes it (L5762–5784), so the planners that need proximity (MA RRT,
+//! MA PRM) or specific hits (Evasion RRT) do not compile with it (thesis Table 5.2).
+//!
+//! # Which one to pick
+//! * Small maps, tests, or as a second opinion: [`PolygonMap`] (every query is O(P)).
+//! * Growing maps (patches added while exploring) and any map of more than a few hundred
+//!   patches: [`BBox6dMap`]; it stays exact, and both adding and querying are sublinear.
+//! * Meshes, or comparing with the thesis's Bullet timings: the trimesh backend.
+//! * Raw scans without patch extraction: [`PointCloudMap`], for RRT and PRM only, and only if
+//!   the scan is denser than the robot (see [`point_cloud`]).
+//!
+//! # Cost of adding
+//!
+//! | backend | adding one patch (P patches, n vertices each) | from scratch |
+//! |---|---|---|
+//! | [`PolygonMap`] | O(n) box + amortised O(1) push | O(P·n) |
+//! | [`BBox6dMap`] | O(n) box + amortised O(log² P) forest insertion | O(P·n + P log P) |
+//! | [`PointCloudMap`] | points: amortised O(log² N) each | O(N log N) |
+//!
+//! # Files and memory
+//! [`MapFile`] saves and loads each backend through the [`mapfile`] container (header with
+//! backend tag and counts, checksums, bincode payload; indices are rebuilt on load);
+//! [`load_any`] reads any of them into an [`AnyMap`]. [`MemoryUsage`] reports the heap bytes a
+//! map owns.
 
+pub mod bbox6d;
+pub mod from_mesh;
 pub mod kdtree;
 pub mod mapfile;
+pub mod persist;
 pub mod point_cloud;
+pub mod polygon;
 pub mod triangulate;
 
+pub use from_mesh::{MeshToPatchesConfig, MeshToPatchesStats, planar_patches_from_mesh};
 pub use point_cloud::{PointCloudMap, PointCloudMapError};
+
+pub use bbox6d::BBox6dMap;
+pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};
+pub use polygon::PolygonMap;
