@@ -113,7 +113,7 @@ pub fn planar_patches_from_mesh(
         let tri = [vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]];
         let cross = (tri[1] - tri[0]).cross(&(tri[2] - tri[0]));
         let area = cross.norm() / 2.0;
-        if !(area > config.min_triangle_area) {
+        if !area.is_finite() || area <= config.min_triangle_area {
             stats.degenerate_triangles += 1;
             continue;
         }

@@ -17,6 +17,8 @@
 //!
 //! Both are checked against a linear scan on random inputs.
 
+use std::ops::ControlFlow;
+
 /// Ranges of at most this many points are scanned linearly instead of split further.
 const LEAF_SIZE: usize = 8;
 
@@ -81,6 +83,17 @@ impl<const K: usize> StaticKdTree<K> {
         out
     }
 
+    /// Calls `f(item)` for points in the closed range until `f` breaks; returns the break
+    /// value, or `Continue` after every point in the range was visited (an any-hit query:
+    /// the traversal stops at the first break).
+    pub fn try_for_each_in_range<B>(
+        &self,
+        query: &RangeQuery<K>,
+        f: &mut impl FnMut(u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        self.try_visit(0, self.points.len(), 0, query, f)
+    }
+
     /// The bytes this tree owns (points and item ids; not the struct itself).
     pub fn memory_bytes(&self) -> usize {
         self.points.capacity() * std::mem::size_of::<[f64; K]>()
@@ -118,6 +131,39 @@ impl<const K: usize> StaticKdTree<K> {
         if query.max[axis].partial_cmp(&split) != Some(Less) {
             self.visit(mid + 1, hi, depth + 1, query, f);
         }
+    }
+
+    /// [`visit`](Self::visit) with early exit.
+    fn try_visit<B>(
+        &self,
+        lo: usize,
+        hi: usize,
+        depth: usize,
+        query: &RangeQuery<K>,
+        f: &mut impl FnMut(u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        if hi - lo <= LEAF_SIZE {
+            for i in lo..hi {
+                if query.contains(&self.points[i]) {
+                    f(self.items[i])?;
+                }
+            }
+            return ControlFlow::Continue(());
+        }
+        let mid = lo + (hi - lo) / 2;
+        let axis = depth % K;
+        let split = self.points[mid][axis];
+        if query.contains(&self.points[mid]) {
+            f(self.items[mid])?;
+        }
+        use std::cmp::Ordering::{Greater, Less};
+        if query.min[axis].partial_cmp(&split) != Some(Greater) {
+            self.try_visit(lo, mid, depth + 1, query, f)?;
+        }
+        if query.max[axis].partial_cmp(&split) != Some(Less) {
+            self.try_visit(mid + 1, hi, depth + 1, query, f)?;
+        }
+        ControlFlow::Continue(())
     }
 
     fn into_entries(self) -> impl Iterator<Item = ([f64; K], u32)> {
@@ -219,6 +265,19 @@ impl<const K: usize> KdForest<K> {
         out
     }
 
+    /// Calls `f(item)` for points in the closed range until `f` breaks (see
+    /// [`StaticKdTree::try_for_each_in_range`]).
+    pub fn try_for_each_in_range<B>(
+        &self,
+        query: &RangeQuery<K>,
+        f: &mut impl FnMut(u32) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        for tree in self.levels.iter().flatten() {
+            tree.try_for_each_in_range(query, f)?;
+        }
+        ControlFlow::Continue(())
+    }
+
     /// The bytes the trees own.
     pub fn memory_bytes(&self) -> usize {
         self.levels.capacity() * std::mem::size_of::<Option<StaticKdTree<K>>>()
@@ -289,6 +348,22 @@ mod tests {
             for q in &qs {
                 prop_assert_eq!(sorted(forest.items_in_range(q)), linear(&e, q));
                 prop_assert_eq!(sorted(bulk.items_in_range(q)), linear(&e, q));
+                // Early exit: visiting everything agrees with the plain query, and breaking
+                // at the first item visits exactly one item iff the range is not empty.
+                let mut all = Vec::new();
+                let flow = forest.try_for_each_in_range(q, &mut |i| {
+                    all.push(i);
+                    ControlFlow::<()>::Continue(())
+                });
+                prop_assert!(flow.is_continue());
+                prop_assert_eq!(sorted(all), linear(&e, q));
+                let mut visited = 0;
+                let flow = forest.try_for_each_in_range(q, &mut |i| {
+                    visited += 1;
+                    ControlFlow::Break(i)
+                });
+                prop_assert_eq!(visited, usize::from(!linear(&e, q).is_empty()));
+                prop_assert_eq!(flow.break_value().is_some(), visited == 1);
             }
         }
     }

@@ -13,10 +13,10 @@
 //!   prune"): each patch's box as a point in a 6D k-d forest ([`kdtree`]), one orthogonal range
 //!   query per check, exact kernels on the candidates.
 //! * `TrimeshMap` — the role of the thesis's BulletPatchMap (L5572–5582): planar patches
-//!   triangulated ([`triangulate`]) into one parry triangle mesh with a BVH. *Being added in
-//!   parallel (module `trimesh`).*
+//!   triangulated ([`triangulate`]) into one parry triangle mesh with a BVH. *In progress (module
+//!   `trimesh`).*
 //! * `RapierMap` — one collider per patch in a rapier query pipeline (a dynamic broad phase).
-//!   *Being added in parallel (module `rapier`).*
+//!   *In progress (module `rapier`).*
 //! * [`PointCloudMap`] — the thesis's PointCloudMap (L5584–5784): no patches at all; the scan
 //!   points in k-d trees and Algorithm 10 for capsule steps ([`point_cloud`]).
 //!
@@ -71,6 +71,7 @@ pub mod persist;
 pub mod point_cloud;
 pub mod polygon;
 pub mod triangulate;
+pub mod trimesh;
 
 pub use from_mesh::{MeshToPatchesConfig, MeshToPatchesStats, planar_patches_from_mesh};
 pub use point_cloud::{PointCloudMap, PointCloudMapError};
@@ -78,3 +79,4 @@ pub use point_cloud::{PointCloudMap, PointCloudMapError};
 pub use bbox6d::BBox6dMap;
 pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};
 pub use polygon::PolygonMap;
+pub use trimesh::{MeshMapError, TrimeshMap};

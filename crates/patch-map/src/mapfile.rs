@@ -115,6 +115,12 @@ pub enum MapFileError {
         /// The backend in the file.
         found: String,
     },
+    /// The file holds a map of a backend this build does not know.
+    #[error("map file holds a `{found}` map, which this build cannot load")]
+    UnknownBackend {
+        /// The backend in the file.
+        found: String,
+    },
     /// The backend tag is empty, not printable ASCII, or longer than 16 bytes.
     #[error("bad backend tag {0:?}")]
     BadTag(String),

@@ -36,6 +36,7 @@
 //! a nearest-neighbour query asks at most `log₂ n + 1` trees.
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use patch_core::{CapsuleStep, LineStep, Step, UnspecificStepIntersector};
 use pointcloud::{Aabb, Point3, Real};
 
 /// One static level: the points and their tree (items are indices into `points`).
@@ -225,6 +226,26 @@ impl PointCloudMap {
             .iter()
             .flatten()
             .flat_map(|l| l.points.iter().map(|p| Point3::new(p[0], p[1], p[2])))
+    }
+}
+
+/// Thesis §5.4.2: the point-cloud map is an Unspecific*Capsule*Intersector only (no proximity,
+/// no specific queries, not a patch map). [`PointCloudMap::capsule_is_free`] with the step's
+/// radius; exact against the points, conservative by at most about
+/// `MIN_ADVANCE² / (2r)` for grazing steps, and a check against the sampled *surface* only
+/// under the density assumption of the [module docs](self).
+impl UnspecificStepIntersector<CapsuleStep> for PointCloudMap {
+    fn is_step_free(&self, step: &CapsuleStep) -> bool {
+        self.capsule_is_free(&step.start(), &step.end(), step.radius())
+    }
+}
+
+/// The line variant: [`PointCloudMap::capsule_is_free`] with radius 0. A segment almost never
+/// meets a sample exactly, so against a sampled surface this answer is meaningful only as the
+/// thesis's "approximation"; prefer capsule steps of the robot's radius.
+impl UnspecificStepIntersector<LineStep> for PointCloudMap {
+    fn is_step_free(&self, step: &LineStep) -> bool {
+        self.capsule_is_free(&step.start(), &step.end(), 0.0)
     }
 }
 
