@@ -70,6 +70,7 @@ pub mod mapfile;
 pub mod persist;
 pub mod point_cloud;
 pub mod polygon;
+pub mod rapier;
 pub mod triangulate;
 pub mod trimesh;
 
@@ -79,4 +80,5 @@ pub use point_cloud::{PointCloudMap, PointCloudMapError};
 pub use bbox6d::BBox6dMap;
 pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};
 pub use polygon::PolygonMap;
+pub use rapier::RapierMap;
 pub use trimesh::{MeshMapError, TrimeshMap};

@@ -15,6 +15,8 @@
 //! | [`PolygonMap`] | `polygon` | patches | patch boxes, O(P·n) |
 //! | [`BBox6dMap`] | `bbox6d` | patches | 6D k-d forest, O(P log P) |
 //! | [`PointCloudMap`] | `pointcloud` | points | k-d trees, O(N log N) |
+//! | [`TrimeshMap`] | `trimesh` | patches | triangulation, one parry mesh and BVH, O(n log n) for n triangles |
+//! | [`RapierMap`] | `rapier` | patches | triangulation, one collider each, broad-phase insertions |
 
 use std::io::{Read, Write};
 
@@ -24,7 +26,7 @@ use patch_core::{
 };
 
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
-use crate::{BBox6dMap, PointCloudMap, PolygonMap};
+use crate::{BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
 
 /// A map that can be written to and read from a map file ([`mapfile`](crate::mapfile)).
 pub trait MapFile: Sized {
@@ -203,9 +205,10 @@ pub enum AnyMap {
     BBox6d(BBox6dMap),
     /// A [`PointCloudMap`] (tag `pointcloud`).
     PointCloud(PointCloudMap),
-    // ---- Further backends go here: `Trimesh(TrimeshMap)` (tag `trimesh`) and
-    // ---- `Rapier(RapierMap)` (tag `rapier`), with their arms in every match of this module
-    // ---- and in `load_any`.
+    /// A [`TrimeshMap`] (tag `trimesh`).
+    Trimesh(TrimeshMap),
+    /// A [`RapierMap`] (tag `rapier`).
+    Rapier(RapierMap),
 }
 
 impl AnyMap {
@@ -215,6 +218,8 @@ impl AnyMap {
             AnyMap::Polygon(_) => PolygonMap::BACKEND,
             AnyMap::BBox6d(_) => BBox6dMap::BACKEND,
             AnyMap::PointCloud(_) => PointCloudMap::BACKEND,
+            AnyMap::Trimesh(_) => TrimeshMap::BACKEND,
+            AnyMap::Rapier(_) => RapierMap::BACKEND,
         }
     }
 
@@ -224,6 +229,8 @@ impl AnyMap {
             AnyMap::Polygon(m) => m.memory_bytes(),
             AnyMap::BBox6d(m) => m.memory_bytes(),
             AnyMap::PointCloud(m) => MemoryUsage::memory_bytes(m),
+            AnyMap::Trimesh(m) => m.memory_bytes(),
+            AnyMap::Rapier(m) => MemoryUsage::memory_bytes(m),
         }
     }
 
@@ -233,6 +240,8 @@ impl AnyMap {
             AnyMap::Polygon(m) => m.counts(),
             AnyMap::BBox6d(m) => m.counts(),
             AnyMap::PointCloud(m) => m.counts(),
+            AnyMap::Trimesh(m) => m.counts(),
+            AnyMap::Rapier(m) => m.counts(),
         }
     }
 
@@ -245,6 +254,8 @@ impl AnyMap {
             AnyMap::Polygon(m) => m.save(writer),
             AnyMap::BBox6d(m) => m.save(writer),
             AnyMap::PointCloud(m) => m.save(writer),
+            AnyMap::Trimesh(m) => m.save(writer),
+            AnyMap::Rapier(m) => m.save(writer),
         }
     }
 
@@ -254,6 +265,8 @@ impl AnyMap {
             AnyMap::Polygon(m) => Some(m.patches()),
             AnyMap::BBox6d(m) => Some(m.patches()),
             AnyMap::PointCloud(_) => None,
+            AnyMap::Trimesh(m) => Some(m.patches()),
+            AnyMap::Rapier(m) => Some(m.patches()),
         }
     }
 }
@@ -266,6 +279,8 @@ impl UnspecificStepIntersector<CapsuleStep> for AnyMap {
             AnyMap::Polygon(m) => m.is_step_free(step),
             AnyMap::BBox6d(m) => m.is_step_free(step),
             AnyMap::PointCloud(m) => m.is_step_free(step),
+            AnyMap::Trimesh(m) => m.is_step_free(step),
+            AnyMap::Rapier(m) => m.is_step_free(step),
         }
     }
 }
@@ -277,6 +292,8 @@ impl UnspecificStepIntersector<LineStep> for AnyMap {
             AnyMap::Polygon(m) => m.is_step_free(step),
             AnyMap::BBox6d(m) => m.is_step_free(step),
             AnyMap::PointCloud(m) => m.is_step_free(step),
+            AnyMap::Trimesh(m) => m.is_step_free(step),
+            AnyMap::Rapier(m) => m.is_step_free(step),
         }
     }
 }
@@ -296,7 +313,8 @@ pub fn load_any(mut reader: impl Read) -> Result<AnyMap, MapFileError> {
         PolygonMap::BACKEND => PolygonMap::load(whole).map(AnyMap::Polygon),
         BBox6dMap::BACKEND => BBox6dMap::load(whole).map(AnyMap::BBox6d),
         PointCloudMap::BACKEND => PointCloudMap::load(whole).map(AnyMap::PointCloud),
-        // ---- Further backends: `TrimeshMap::BACKEND => ...`, `RapierMap::BACKEND => ...`.
+        TrimeshMap::BACKEND => TrimeshMap::load(whole).map(AnyMap::Trimesh),
+        RapierMap::BACKEND => RapierMap::load(whole).map(AnyMap::Rapier),
         _ => Err(MapFileError::UnknownBackend { found: header.backend }),
     }
 }

@@ -229,3 +229,15 @@ mod trimesh_map {
         capsule_unspecific, capsule_specific, clearance_vs_capsule,
     );
 }
+
+/// The rapier map: one collider per patch in rapier's broad phase, the trimesh map's per-mesh
+/// narrow phase in each collider, hence its tolerance.
+mod rapier_map {
+    use super::*;
+    patch_core::conformance_tests!(
+        patch_map::RapierMap,
+        SuiteConfig::from_env(patch_map::RapierMap::TOLERANCE, SceneKind::Mixed);
+        map, map_mut, proximity, line_unspecific, line_specific,
+        capsule_unspecific, capsule_specific, clearance_vs_capsule,
+    );
+}

@@ -4,6 +4,8 @@
 //! patchnav info FILE                      what a file holds
 //! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
+//! patchnav map build INPUT --backend polygon|bbox6d|trimesh|pointcloud --out MAP
+//! patchnav map info MAP
 //! ```
 //!
 //! Errors are printed as one line on standard error and the exit code is 1 (2 for usage errors,
@@ -16,6 +18,7 @@ use std::process::ExitCode;
 mod convert;
 mod info;
 mod input;
+mod map;
 mod progress;
 mod simulate;
 
@@ -50,6 +53,9 @@ enum Command {
     },
     /// Scan a synthetic scene with a simulated sensor from several poses.
     Simulate(simulate::SimulateArgs),
+    /// Build and inspect map files.
+    #[command(subcommand)]
+    Map(map::MapCommand),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +67,7 @@ fn main() -> ExitCode {
             convert::run(&input, &output, &options, &progress)
         }
         Command::Simulate(args) => simulate::run(&args, &progress),
+        Command::Map(command) => map::run(&command, &progress),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

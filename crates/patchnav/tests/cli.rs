@@ -193,3 +193,141 @@ fn errors_are_one_line_with_exit_code_one() {
         "--step-deg",
     );
 }
+
+/// A small OBJ: a 4 × 3 floor of two triangles and a wall of two quads meeting in a T-junction.
+fn write_small_obj(dir: &Path) -> PathBuf {
+    let obj = dir.join("room.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 4 0 0\nv 4 3 0\nv 0 3 0\n\
+         v 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\n\
+         v 2 0 0\nv 4 0 0\nv 4 0 2\nv 2 0 2\n\
+         f 1 2 3\nf 1 3 4\nf 5 6 7 8\nf 9 10 11 12\n",
+    )
+    .unwrap();
+    obj
+}
+
+fn info_field(text: &str, field: &str) -> String {
+    text.lines()
+        .find(|l| l.starts_with(field))
+        .unwrap_or_else(|| panic!("no `{field}` in {text}"))
+        .split(':')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .to_owned()
+}
+
+#[test]
+fn map_build_and_info_for_every_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write_small_obj(dir.path());
+    for backend in ["polygon", "bbox6d", "trimesh"] {
+        let out = dir.path().join(format!("{backend}.pmap"));
+        let o = patchnav(&[
+            "map",
+            "build",
+            obj.to_str().unwrap(),
+            "--backend",
+            backend,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{backend}: {}", stderr(&o));
+        assert!(stdout(&o).contains("2 planar patches"), "{}", stdout(&o));
+        let info = stdout(&patchnav(&["map", "info", out.to_str().unwrap()]));
+        assert!(info_field(&info, "backend").starts_with(backend), "{info}");
+        assert_eq!(info_field(&info, "planar patches"), "2", "{info}");
+        assert!(info.contains("size 4.000 × 3.000 × 2.000 m"), "{info}");
+        let file_bytes: u64 = info_field(&info, "file bytes").parse().unwrap();
+        assert_eq!(file_bytes, std::fs::metadata(&out).unwrap().len());
+        assert!(info_field(&info, "memory bytes").parse::<u64>().unwrap() > 0);
+    }
+    // A map file converts to another backend.
+    let back = dir.path().join("again.pmap");
+    let from = dir.path().join("polygon.pmap");
+    let o = patchnav(&[
+        "map",
+        "build",
+        from.to_str().unwrap(),
+        "--backend",
+        "bbox6d",
+        "--out",
+        back.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A point cloud builds the point-cloud backend, and only that.
+    let pc = dir.path().join("cloud.pmap");
+    let scan = fixture("lab-alrf-2deg.ply");
+    let o = patchnav(&[
+        "map",
+        "build",
+        &scan,
+        "--backend",
+        "pointcloud",
+        "--out",
+        pc.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = stdout(&patchnav(&["map", "info", pc.to_str().unwrap()]));
+    let scan_points = info_field(&stdout(&patchnav(&["info", &scan])), "points");
+    assert_eq!(info_field(&info, "points"), scan_points);
+    assert_one_line_error(
+        &patchnav(&[
+            "map",
+            "build",
+            &scan,
+            "--backend",
+            "polygon",
+            "--out",
+            back.to_str().unwrap(),
+        ]),
+        "no patches",
+    );
+    assert_one_line_error(
+        &patchnav(&[
+            "map",
+            "build",
+            obj.to_str().unwrap(),
+            "--backend",
+            "pointcloud",
+            "--out",
+            back.to_str().unwrap(),
+        ]),
+        "pointcloud backend",
+    );
+}
+
+#[test]
+fn corrupt_map_files_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write_small_obj(dir.path());
+    let good = dir.path().join("good.pmap");
+    let o = patchnav(&[
+        "-q",
+        "map",
+        "build",
+        obj.to_str().unwrap(),
+        "--backend",
+        "polygon",
+        "--out",
+        good.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&good).unwrap();
+    let cut = dir.path().join("cut.pmap");
+    std::fs::write(&cut, &bytes[..bytes.len() - 3]).unwrap();
+    assert_one_line_error(&patchnav(&["map", "info", cut.to_str().unwrap()]), "truncated");
+    let mut flipped = bytes.clone();
+    let last = flipped.len() - 1;
+    flipped[last] ^= 0x10;
+    let bad = dir.path().join("bad.pmap");
+    std::fs::write(&bad, &flipped).unwrap();
+    assert_one_line_error(&patchnav(&["map", "info", bad.to_str().unwrap()]), "corrupt");
+    let mut future = bytes;
+    future[8] = 9;
+    std::fs::write(&bad, &future).unwrap();
+    assert_one_line_error(&patchnav(&["map", "info", bad.to_str().unwrap()]), "version 9");
+    assert_one_line_error(&patchnav(&["map", "info", obj.to_str().unwrap()]), "not a patch map");
+}

@@ -1,0 +1,208 @@
+//! `patchnav map build INPUT --backend B --out MAP` and `patchnav map info MAP`.
+
+use crate::input::InputArgs;
+use crate::progress::Progress;
+use anyhow::{Context, Result, bail};
+use clap::{Args, Subcommand, ValueEnum};
+use patch_core::{FromPatches, Patch, PatchMap, Point3};
+use patch_map::mapfile::read_header;
+use patch_map::{
+    AnyMap, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap, PolygonMap,
+    TrimeshMap, load_any, planar_patches_from_mesh,
+};
+use pointcloud::Aabb;
+use pointcloud::io::{self, Format};
+use std::fs::File;
+use std::io::{BufReader, BufWriter};
+use std::path::{Path, PathBuf};
+
+/// `patchnav map ...`.
+#[derive(Subcommand, Debug)]
+pub enum MapCommand {
+    /// Build a map file from a mesh (its coplanar faces become planar patches), a point cloud
+    /// (point-cloud backend only) or another map file.
+    Build(BuildArgs),
+    /// Print a map file's backend, counts, bounds, memory and file size.
+    Info {
+        /// A map file written by `patchnav map build`.
+        file: PathBuf,
+    },
+}
+
+/// The backends `map build` offers.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BackendChoice {
+    /// Native polygons, no broad phase (the thesis's SimplePatchMap).
+    Polygon,
+    /// Patch boxes as 6D points in a k-d forest (the thesis's BoundingBox6DPatchMap).
+    Bbox6d,
+    /// Triangulated patches in one parry triangle mesh with a BVH.
+    Trimesh,
+    /// The points themselves, checked by the thesis's Algorithm 10.
+    Pointcloud,
+}
+
+/// Arguments of `patchnav map build`.
+#[derive(Args, Debug)]
+pub struct BuildArgs {
+    /// An OBJ mesh, a point cloud (.ply .pcd .xyz .bin .3d .png) or a map file (.pmap).
+    pub input: PathBuf,
+    /// The backend of the new map.
+    #[arg(long, value_enum)]
+    pub backend: BackendChoice,
+    /// The map file to write (conventionally `.pmap`).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub input_options: InputArgs,
+}
+
+/// What a map is built from.
+enum Source {
+    Patches(Vec<Patch>),
+    Points(Vec<Point3>),
+}
+
+/// Runs `patchnav map ...`.
+pub fn run(command: &MapCommand, progress: &Progress) -> Result<()> {
+    match command {
+        MapCommand::Build(args) => build(args, progress),
+        MapCommand::Info { file } => {
+            print!("{}", describe(file)?);
+            Ok(())
+        }
+    }
+}
+
+fn is_map_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pmap"))
+}
+
+fn load_source(input: &Path, options: &InputArgs, progress: &Progress) -> Result<Source> {
+    if is_map_file(input) {
+        let map = open_map(input)?;
+        return Ok(match (map.patches(), &map) {
+            (Some(patches), _) => Source::Patches(patches.to_vec()),
+            (None, AnyMap::PointCloud(m)) => Source::Points(m.points().collect()),
+            (None, other) => bail!(
+                "{}: a `{}` map has neither patches nor points",
+                input.display(),
+                other.backend()
+            ),
+        });
+    }
+    match Format::from_path(input) {
+        Some(Format::Obj) => {
+            let mesh = io::read_mesh(input)?;
+            let (patches, stats) =
+                planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
+            progress.say(format!(
+                "{}: {} faces -> {} planar patches, {} trimesh patches, {} degenerate triangles dropped",
+                input.display(),
+                mesh.faces().len(),
+                stats.planar_patches,
+                stats.trimesh_fallbacks,
+                stats.degenerate_triangles
+            ));
+            Ok(Source::Patches(patches))
+        }
+        Some(_) => {
+            let cloud = crate::input::read_cloud(input, options)?.to_world();
+            Ok(Source::Points(cloud.positions().to_vec()))
+        }
+        None => bail!("{}: unknown input extension", input.display()),
+    }
+}
+
+fn open_map(path: &Path) -> Result<AnyMap> {
+    let file = File::open(path).with_context(|| format!("opening {}", path.display()))?;
+    load_any(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))
+}
+
+fn save<M: MapFile + MemoryUsage>(map: &M, out: &Path) -> Result<(u64, usize)> {
+    let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
+    let bytes =
+        map.save(BufWriter::new(file)).with_context(|| format!("writing {}", out.display()))?;
+    Ok((bytes, map.memory_bytes()))
+}
+
+fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
+    let source = load_source(&args.input, &args.input_options, progress)?;
+    let spinner = progress.spinner("building");
+    let patches = |what: &str| -> Result<Vec<Patch>> {
+        match &source {
+            Source::Patches(p) => Ok(p.clone()),
+            Source::Points(_) => bail!(
+                "{}: a point cloud has no patches; the {what} backend needs a mesh or a patch map \
+                 (or use --backend pointcloud)",
+                args.input.display()
+            ),
+        }
+    };
+    let (bytes, memory) = match args.backend {
+        BackendChoice::Polygon => save(&PolygonMap::from_patches(patches("polygon")?)?, &args.out)?,
+        BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches("bbox6d")?)?, &args.out)?,
+        BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches("trimesh")?)?, &args.out)?,
+        BackendChoice::Pointcloud => match &source {
+            Source::Points(points) => save(&PointCloudMap::from_points(points)?, &args.out)?,
+            Source::Patches(_) => bail!(
+                "{}: the pointcloud backend is built from a point cloud, not from patches",
+                args.input.display()
+            ),
+        },
+    };
+    spinner.finish_and_clear();
+    progress.say(format!(
+        "wrote {} ({:?} backend, {bytes} bytes on disk, {memory} bytes in memory)",
+        args.out.display(),
+        args.backend
+    ));
+    Ok(())
+}
+
+/// The text `map info` prints.
+pub fn describe(path: &Path) -> Result<String> {
+    use std::fmt::Write as _;
+    let file = File::open(path).with_context(|| format!("opening {}", path.display()))?;
+    let header =
+        read_header(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))?;
+    let map = open_map(path)?;
+    let file_bytes = std::fs::metadata(path)?.len();
+    let bounds = match &map {
+        AnyMap::PointCloud(m) => m.bounds(),
+        AnyMap::Polygon(m) => m.bounds(),
+        AnyMap::BBox6d(m) => m.bounds(),
+        _ => map
+            .patches()
+            .map_or(Aabb::EMPTY, |p| p.iter().fold(Aabb::EMPTY, |b, q| b.union(&q.bounds()))),
+    };
+    let c = header.counts;
+    let mut out = String::new();
+    writeln!(out, "file:            {}", path.display())?;
+    writeln!(out, "backend:         {} (format version {})", header.backend, header.version)?;
+    writeln!(out, "planar patches:  {}", c.planar_patches)?;
+    writeln!(out, "trimesh patches: {}", c.trimesh_patches)?;
+    writeln!(out, "triangles:       {}", c.triangles)?;
+    writeln!(out, "points:          {}", c.points)?;
+    if bounds.is_empty() {
+        writeln!(out, "bounds:          empty")?;
+    } else {
+        let e = bounds.extents();
+        writeln!(
+            out,
+            "bounds:          ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3}) m, size {:.3} × {:.3} × {:.3} m",
+            bounds.min.x,
+            bounds.min.y,
+            bounds.min.z,
+            bounds.max.x,
+            bounds.max.y,
+            bounds.max.z,
+            e.x,
+            e.y,
+            e.z
+        )?;
+    }
+    writeln!(out, "memory bytes:    {}", map.memory_bytes())?;
+    writeln!(out, "file bytes:      {file_bytes}")?;
+    Ok(out)
+}
