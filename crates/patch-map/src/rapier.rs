@@ -57,6 +57,15 @@ use crate::trimesh::{
     AFTER_END, MeshMapError, Probe, complete_hit, next_id, valid_proximity_query, world_triangles,
 };
 
+/// The rapier structures of a [`RapierMap`].
+#[derive(Clone)]
+struct World {
+    colliders: ColliderSet,
+    /// Empty: the colliders have no parent body, but the pipeline takes a body set.
+    bodies: RigidBodySet,
+    broad_phase: BroadPhaseBvh,
+}
+
 /// The rapier map (thesis §5.4.2, the BulletPatchMap set-up): one collider per patch in a
 /// rapier collider set and broad phase; see the [module docs](self).
 ///
@@ -74,10 +83,8 @@ use crate::trimesh::{
 pub struct RapierMap {
     patches: Vec<Patch>,
     bounds: Aabb,
-    colliders: ColliderSet,
-    /// Empty: the colliders have no parent body, but the pipeline takes a body set.
-    bodies: RigidBodySet,
-    broad_phase: BroadPhaseBvh,
+    /// Boxed: rapier's sets are large values (about a kilobyte), the map stays small.
+    world: Box<World>,
     triangles: usize,
 }
 
@@ -108,9 +115,11 @@ impl RapierMap {
         RapierMap {
             patches: Vec::new(),
             bounds: Aabb::EMPTY,
-            colliders: ColliderSet::new(),
-            bodies: RigidBodySet::new(),
-            broad_phase: BroadPhaseBvh::new(),
+            world: Box::new(World {
+                colliders: ColliderSet::new(),
+                bodies: RigidBodySet::new(),
+                broad_phase: BroadPhaseBvh::new(),
+            }),
             triangles: 0,
         }
     }
@@ -145,8 +154,8 @@ impl RapierMap {
                 .user_data(u128::from(id.0))
                 .build();
         let aabb = collider.compute_aabb();
-        let handle = self.colliders.insert(collider);
-        self.broad_phase.set_aabb(&IntegrationParameters::default(), handle, aabb);
+        let handle = self.world.colliders.insert(collider);
+        self.world.broad_phase.set_aabb(&IntegrationParameters::default(), handle, aabb);
         self.bounds = self.bounds.union(&patch.bounds());
         self.patches.push(patch);
         self.triangles += k;
@@ -163,16 +172,17 @@ impl RapierMap {
 
     /// The rapier query pipeline over the colliders (no filter).
     pub fn query_pipeline(&self) -> QueryPipeline<'_> {
-        self.broad_phase.as_query_pipeline(
+        self.world.broad_phase.as_query_pipeline(
             &DefaultQueryDispatcher,
-            &self.bodies,
-            &self.colliders,
+            &self.world.bodies,
+            &self.world.colliders,
             QueryFilter::default(),
         )
     }
 
     /// The heap bytes this map can see: the patch list
-    /// ([`patches_memory_bytes`](crate::persist::patches_memory_bytes)), one [`Collider`] per
+    /// ([`patches_memory_bytes`]), the boxed rapier sets
+    /// (collider set, empty body set, broad phase: their inline parts), one [`Collider`] per
     /// patch in the set, each collider's triangle mesh (the shape value behind its `Arc` plus
     /// parry's count of its vertices, indices and BVH nodes from their capacities) and the
     /// broad-phase BVH (parry's count of its nodes). Not visible, so not counted: the spare
@@ -180,6 +190,7 @@ impl RapierMap {
     /// `Arc` headers and the broad phase's (unused) pair table.
     pub fn memory_bytes(&self) -> usize {
         let colliders: usize = self
+            .world
             .colliders
             .iter()
             .map(|(_, c)| {
@@ -190,6 +201,7 @@ impl RapierMap {
             })
             .sum();
         patches_memory_bytes(&self.patches)
+            + size_of::<World>()
             + colliders
             + self.query_pipeline().bvh.heap_memory_size()
     }
@@ -199,7 +211,7 @@ impl RapierMap {
 impl RapierMap {
     /// The patch and triangle mesh of the collider at BVH leaf `leaf`.
     fn collider(&self, leaf: u32) -> Option<(PatchId, &TriMesh)> {
-        let (collider, _) = self.colliders.get_unknown_gen(leaf)?;
+        let (collider, _) = self.world.colliders.get_unknown_gen(leaf)?;
         let id = PatchId(u32::try_from(collider.user_data).ok()?);
         Some((id, collider.shape().as_trimesh()?))
     }
@@ -276,7 +288,7 @@ impl ProximityQuery for RapierMap {
         }
         let (handle, proj) = self.query_pipeline().project_point(point, max_dist, false)?;
         let distance = (proj.point - point).norm();
-        let id = u32::try_from(self.colliders.get(handle)?.user_data).ok()?;
+        let id = u32::try_from(self.world.colliders.get(handle)?.user_data).ok()?;
         (distance <= max_dist).then_some(Proximity {
             patch: PatchId(id),
             point: proj.point,
