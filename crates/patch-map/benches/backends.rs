@@ -1,6 +1,8 @@
 //! Collision-query throughput of the patch-map backends (thesis §5.5.3–5.5.4 compared the
-//! backends' planning times; this isolates their queries): one BVH over all triangles
-//! ([`TrimeshMap`]) against one collider per patch in rapier's broad phase ([`RapierMap`]).
+//! backends' planning times; this isolates their queries): native polygons without a broad
+//! phase ([`PolygonMap`]), patch boxes in a 6D k-d forest ([`BBox6dMap`]), one BVH over all
+//! triangles ([`TrimeshMap`]) and one collider per patch in rapier's broad phase
+//! ([`RapierMap`]).
 //!
 //! Scenes:
 //! * `random`: 3000 random planar patches (rectangles and star-shaped polygons, 0.2–2 m,
@@ -24,7 +26,7 @@ use patch_core::{
     Aabb, CapsuleStep, FromPatches, Isometry3, LineStep, Patch, PlanarPatch, Point2, Point3,
     Polygon, Real, SpecificStepIntersector, UnspecificStepIntersector, Vector3, na,
 };
-use patch_map::{RapierMap, TrimeshMap};
+use patch_map::{BBox6dMap, PolygonMap, RapierMap, TrimeshMap};
 
 /// The robot radius.
 const RADIUS: Real = 0.3;
@@ -35,6 +37,8 @@ const BATCH: usize = 256;
 
 /// The backends compared: one line each.
 fn backends(c: &mut Criterion, scene: &Scene) {
+    bench_backend::<PolygonMap>(c, scene, "polygon");
+    bench_backend::<BBox6dMap>(c, scene, "bbox6d");
     bench_backend::<TrimeshMap>(c, scene, "trimesh");
     bench_backend::<RapierMap>(c, scene, "rapier");
 }

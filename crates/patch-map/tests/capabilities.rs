@@ -9,7 +9,9 @@ use patch_core::{
     CapsuleStep, Counted, FromPatches, LineStep, PatchMap, PatchMapMut, ProximityQuery,
     SpecificStepIntersector, UnspecificStepIntersector,
 };
-use patch_map::{AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap};
+use patch_map::{
+    AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
+};
 
 fn assert_patch_map<T: PatchMap>() {}
 fn assert_patch_map_mut<T: PatchMapMut>() {}
@@ -75,7 +77,14 @@ fn positive_table() {
     assert_proximity::<&BBox6dMap>();
     assert_capsule_specific::<&PolygonMap>();
 
-    // ---- Further backends (TrimeshMap, RapierMap) add their rows here.
+    // TrimeshMap and RapierMap: everything.
+    assert_full::<TrimeshMap>();
+    assert_map_file::<TrimeshMap>();
+    assert_memory_usage::<TrimeshMap>();
+    assert_send_sync::<TrimeshMap>();
+    assert_full::<RapierMap>();
+    assert_map_file::<RapierMap>();
+    assert_memory_usage::<RapierMap>();
 }
 
 /// `implements!(T: Trait)`: whether the concrete type `T` implements `Trait`, as a `bool`
@@ -132,5 +141,12 @@ fn full_table() {
     );
     // The probe itself: a negative answer for a type that certainly lacks the trait.
     assert!(!implements!(u8: PatchMap));
-    // ---- Further backends (TrimeshMap, RapierMap) add their rows here.
+    // TrimeshMap and RapierMap: everything.
+    assert_full::<TrimeshMap>();
+    assert_map_file::<TrimeshMap>();
+    assert_memory_usage::<TrimeshMap>();
+    assert_send_sync::<TrimeshMap>();
+    assert_full::<RapierMap>();
+    assert_map_file::<RapierMap>();
+    assert_memory_usage::<RapierMap>();
 }

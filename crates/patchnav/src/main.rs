@@ -4,7 +4,7 @@
 //! patchnav info FILE                      what a file holds
 //! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
-//! patchnav map build INPUT --backend polygon|bbox6d|trimesh|pointcloud --out MAP
+//! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
 //! ```
 //!

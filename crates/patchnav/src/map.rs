@@ -1,4 +1,7 @@
 //! `patchnav map build INPUT --backend B --out MAP` and `patchnav map info MAP`.
+//!
+//! `--backend`: `polygon`, `bbox6d`, `trimesh`, `rapier` (from a mesh or a patch map) or
+//! `pointcloud` (from a point cloud or a point-cloud map).
 
 use crate::input::InputArgs;
 use crate::progress::Progress;
@@ -8,7 +11,7 @@ use patch_core::{FromPatches, Patch, PatchMap, Point3};
 use patch_map::mapfile::read_header;
 use patch_map::{
     AnyMap, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap, PolygonMap,
-    TrimeshMap, load_any, planar_patches_from_mesh,
+    RapierMap, TrimeshMap, load_any, planar_patches_from_mesh,
 };
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
@@ -38,6 +41,8 @@ pub enum BackendChoice {
     Bbox6d,
     /// Triangulated patches in one parry triangle mesh with a BVH.
     Trimesh,
+    /// One collider per patch in a rapier query pipeline.
+    Rapier,
     /// The points themselves, checked by the thesis's Algorithm 10.
     Pointcloud,
 }
@@ -143,6 +148,7 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         BackendChoice::Polygon => save(&PolygonMap::from_patches(patches("polygon")?)?, &args.out)?,
         BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches("bbox6d")?)?, &args.out)?,
         BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches("trimesh")?)?, &args.out)?,
+        BackendChoice::Rapier => save(&RapierMap::from_patches(patches("rapier")?)?, &args.out)?,
         BackendChoice::Pointcloud => match &source {
             Source::Points(points) => save(&PointCloudMap::from_points(points)?, &args.out)?,
             Source::Patches(_) => bail!(

@@ -223,7 +223,7 @@ fn info_field(text: &str, field: &str) -> String {
 fn map_build_and_info_for_every_backend() {
     let dir = tempfile::tempdir().unwrap();
     let obj = write_small_obj(dir.path());
-    for backend in ["polygon", "bbox6d", "trimesh"] {
+    for backend in ["polygon", "bbox6d", "trimesh", "rapier"] {
         let out = dir.path().join(format!("{backend}.pmap"));
         let o = patchnav(&[
             "map",
