@@ -43,16 +43,16 @@
 //! | Evasion RRT | – | ✓ | – |
 //! | MA RRT, MA PRM | ✓ | – | ✓ |
 //!
-//! and the backends planned in `patch-map` offer (thesis §5.4.2, with capsules added where the
-//! thesis used only Bullet for them):
+//! and the backends of `patch-map` offer (thesis §5.4.2, with capsules added where the thesis
+//! used only Bullet for them; `patch-map`'s crate docs pin the table with compile-time tests):
 //!
 //! | backend | proximity | specific | unspecific | line | capsule |
 //! |---|---|---|---|---|---|
 //! | [`BruteForceMap`] (reference) | ✓ | ✓ | ✓ | ✓ | ✓ |
 //! | native polygon map | ✓ | ✓ | ✓ | ✓ | ✓ |
 //! | 6D bounding-box kD-tree | ✓ | ✓ | ✓ | ✓ | ✓ |
-//! | parry trimesh map | ✓ | ✓ | ✓ | ✓ | ✓ |
-//! | point-cloud kD-tree (Alg. 10) | – | – | ✓ | – | ✓ |
+//! | parry trimesh map, rapier collider set | ✓ | ✓ | ✓ | ✓ | ✓ |
+//! | point-cloud kD-tree (Alg. 10; lines as capsules of radius 0) | – | – | ✓ | ✓ | ✓ |
 //!
 //! [`PatchId`]s are insertion indices, the same in every backend, so answers can be compared
 //! across backends. [`Counted`] wraps any map and counts its queries.

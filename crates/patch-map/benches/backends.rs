@@ -6,7 +6,8 @@
 //!
 //! Scenes:
 //! * `random`: 3000 random planar patches (rectangles and star-shaped polygons, 0.2–2 m,
-//!   random orientations) in a 60 × 60 × 6 m box, seeded;
+//!   random orientations) in a 60 × 60 × 6 m box, seeded; `random-30k`: 30,000 at the same
+//!   density (190 × 190 × 6 m);
 //! * `office`: the empty office floor plan of `scene-sim` (walls with doors, floor, ceiling;
 //!   §5.5.3, Fig. 5.19), each scene polygon one planar patch (doors that reach a wall's edge
 //!   become notches of its outline).
@@ -172,12 +173,12 @@ fn steps(rng: &mut Rng, bounds: &Aabb) -> Vec<(Real, Vec<CapsuleStep>)> {
         .collect()
 }
 
-/// 3000 random planar patches in a 60 × 60 × 6 m box.
-fn random_scene() -> Scene {
+/// `count` random planar patches in a box of `side × side × 6` m.
+fn random_scene(name: &'static str, count: usize, side: Real) -> Scene {
     let mut rng = Rng(0x5eed_2010_0000_0001);
-    let bounds = Aabb::new(Point3::new(0.0, 0.0, 0.0), Point3::new(60.0, 60.0, 6.0));
+    let bounds = Aabb::new(Point3::new(0.0, 0.0, 0.0), Point3::new(side, side, 6.0));
     let mut patches = Vec::new();
-    while patches.len() < 3000 {
+    while patches.len() < count {
         let rotation = na::UnitQuaternion::from_scaled_axis(
             rng.direction() * rng.range(0.0, std::f64::consts::PI),
         );
@@ -202,7 +203,7 @@ fn random_scene() -> Scene {
         }
     }
     let steps = steps(&mut rng, &bounds);
-    Scene { name: "random", patches, steps }
+    Scene { name, patches, steps }
 }
 
 /// The outline of an axis-aligned rectangle with the rectangular holes that touch its bottom
@@ -285,7 +286,13 @@ fn describe(scene: &Scene) {
 }
 
 fn all(c: &mut Criterion) {
-    for scene in [random_scene(), office_scene()] {
+    // 3000 and 30,000 patches at the same density (the side grows with the square root).
+    let scenes = [
+        random_scene("random", 3000, 60.0),
+        random_scene("random-30k", 30_000, 60.0 * (10.0 as Real).sqrt()),
+        office_scene(),
+    ];
+    for scene in scenes {
         describe(&scene);
         backends(c, &scene);
     }
