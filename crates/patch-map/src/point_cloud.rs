@@ -328,6 +328,18 @@ mod tests {
     }
 
     #[test]
+    fn many_identical_points_build_and_answer() {
+        // Duplicate returns are common in scans; far more than a k-d bucket holds.
+        let pts = vec![Point3::new(1.0, 2.0, 3.0); 1000];
+        let map = PointCloudMap::from_points(&pts).unwrap();
+        assert_eq!(map.len(), 1000);
+        let (p, d) = map.nearest(&Point3::origin()).unwrap();
+        assert_eq!(p, pts[0]);
+        assert!((d - 14f64.sqrt()).abs() < 1e-12);
+        assert!(!map.capsule_is_free(&Point3::origin(), &Point3::new(2.0, 4.0, 6.0), 0.1));
+    }
+
+    #[test]
     fn degenerate_inputs() {
         let empty = PointCloudMap::new();
         let o = Point3::origin();
