@@ -2,7 +2,8 @@
 //! backends' planning times; this isolates their queries): native polygons without a broad
 //! phase ([`PolygonMap`]), patch boxes in a 6D k-d forest ([`BBox6dMap`]), one BVH over all
 //! triangles ([`TrimeshMap`]) and one collider per patch in rapier's broad phase
-//! ([`RapierMap`]).
+//! ([`RapierMap`]), and the point-cloud map ([`PointCloudMap`], Algorithm 10) of the scene's
+//! surfaces sampled every 0.1 m (unspecific queries only, as the thesis scopes it).
 //!
 //! Scenes:
 //! * `random`: 3000 random planar patches (rectangles and star-shaped polygons, 0.2–2 m,
@@ -27,7 +28,7 @@ use patch_core::{
     Aabb, CapsuleStep, FromPatches, Isometry3, LineStep, Patch, PlanarPatch, Point2, Point3,
     Polygon, Real, SpecificStepIntersector, UnspecificStepIntersector, Vector3, na,
 };
-use patch_map::{BBox6dMap, PolygonMap, RapierMap, TrimeshMap};
+use patch_map::{BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap, sample_patch_points};
 
 /// The robot radius.
 const RADIUS: Real = 0.3;
@@ -42,6 +43,41 @@ fn backends(c: &mut Criterion, scene: &Scene) {
     bench_backend::<BBox6dMap>(c, scene, "bbox6d");
     bench_backend::<TrimeshMap>(c, scene, "trimesh");
     bench_backend::<RapierMap>(c, scene, "rapier");
+    bench_point_cloud(c, scene);
+}
+
+/// Sample spacing of the point-cloud map, metres: below r/2, the density Algorithm 10 assumes.
+const SPACING: Real = 0.1;
+
+/// The point-cloud map of the scene's surfaces sampled at [`SPACING`]: its build time and its
+/// two queries (the unspecific ones, all the thesis's point-cloud map offers).
+fn bench_point_cloud(c: &mut Criterion, scene: &Scene) {
+    let points = sample_patch_points(&scene.patches, SPACING).expect("scene patches");
+    let mut g = c.benchmark_group(format!("{}/build", scene.name));
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(scene.patches.len() as u64));
+    g.bench_function("pointcloud", |b| {
+        b.iter(|| PointCloudMap::from_points(black_box(&points)).expect("finite points"))
+    });
+    g.finish();
+    let map = PointCloudMap::from_points(&points).expect("finite points");
+    type Run = fn(&PointCloudMap, &[CapsuleStep]) -> usize;
+    let unspecific: [(&str, Run); 2] = [
+        ("capsule_free", |m, s| s.iter().filter(|s| !m.is_step_free(*s)).count()),
+        ("line_free", |m, s| s.iter().filter(|s| !m.is_step_free(&s.line())).count()),
+    ];
+    for (query, run) in unspecific {
+        let mut g = c.benchmark_group(format!("{}/{query}", scene.name));
+        g.throughput(Throughput::Elements(BATCH as u64));
+        for (length, steps) in &scene.steps {
+            g.bench_with_input(
+                BenchmarkId::new("pointcloud", format!("{length} m")),
+                steps,
+                |b, steps| b.iter(|| run(&map, black_box(steps))),
+            );
+        }
+        g.finish();
+    }
 }
 
 /// Everything a benchmarked backend answers.

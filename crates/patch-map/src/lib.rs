@@ -74,11 +74,13 @@ pub mod persist;
 pub mod point_cloud;
 pub mod polygon;
 pub mod rapier;
+pub mod sampling;
 pub mod triangulate;
 pub mod trimesh;
 
 pub use from_mesh::{MeshToPatchesConfig, MeshToPatchesStats, planar_patches_from_mesh};
 pub use point_cloud::{PointCloudMap, PointCloudMapError};
+pub use sampling::{SamplingError, sample_patch_points};
 
 pub use bbox6d::BBox6dMap;
 pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};

@@ -107,11 +107,8 @@ mod identical_answers {
 /// The point-cloud map on points sampled densely on random patches.
 ///
 /// # Density assumption
-/// Every triangle of the scene (trimesh triangles, and planar patches triangulated by
-/// [`triangulate_polygon`]) is sampled on the lattice `a + (i/n)(b − a) + (j/n)(c − a)`,
-/// `i + j ≤ n`, with `n = ⌈longest edge / h⌉`. The lattice cuts the triangle into copies of it
-/// scaled by `1/n`, whose edges are at most `h`; a triangle lies within its longest edge of each
-/// of its corners, so every surface point is within `h` of a sample. Hence a step whose exact
+/// `patch_map::sample_patch_points` puts every surface point within `h` of a sample (its
+/// module docs prove it). Hence a step whose exact
 /// distance to the patches is `d ≤ r − h` has a sample within `r` of its segment: Algorithm 10
 /// must report it colliding. With `h = 0.1 m` and radii from 0.25 m the spacing is below `r/2`,
 /// the regime the thesis assumes (L5724). In the other direction every sample lies on a patch,
@@ -126,54 +123,15 @@ mod point_cloud_map {
         BruteForceMap, CapsuleStep, FromPatches, Patch, Point3, Real, Step,
         UnspecificStepIntersector,
     };
-    use patch_map::PointCloudMap;
-    use patch_map::triangulate::triangulate_polygon;
+    use patch_map::{PointCloudMap, sample_patch_points};
     use proptest::prelude::*;
 
     /// The sample spacing, metres.
     const SPACING: Real = 0.1;
 
-    fn sample_triangle(corners: [Point3; 3], out: &mut Vec<Point3>) {
-        let [a, b, c] = corners;
-        let longest =
-            [(b - a).norm(), (c - b).norm(), (a - c).norm()].into_iter().fold(0.0, Real::max);
-        let n = (longest / SPACING).ceil().max(1.0) as usize;
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let (u, v) = (i as Real / n as Real, j as Real / n as Real);
-                out.push(a + (b - a) * u + (c - a) * v);
-            }
-        }
-    }
-
-    /// Samples every patch with spacing at most [`SPACING`] (see the module docs).
+    /// Samples every patch with spacing at most [`SPACING`] (the library's sampler).
     fn sample(patches: &[Patch]) -> Vec<Point3> {
-        let mut out = Vec::new();
-        for patch in patches {
-            match patch {
-                Patch::Planar(p) => {
-                    let rings: Vec<Vec<[Real; 2]>> = p
-                        .polygon()
-                        .rings()
-                        .map(|r| r.points().iter().map(|q| [q.x, q.y]).collect())
-                        .collect();
-                    let t = triangulate_polygon(&rings).expect("valid polygons triangulate");
-                    let world = |k: u32| {
-                        let [x, y] = t.vertices[k as usize];
-                        p.to_world(&patch_core::Point2::new(x, y))
-                    };
-                    for tri in &t.triangles {
-                        sample_triangle(tri.map(world), &mut out);
-                    }
-                }
-                Patch::Trimesh(m) => {
-                    for i in 0..m.num_triangles() {
-                        sample_triangle(m.triangle(i), &mut out);
-                    }
-                }
-            }
-        }
-        out
+        sample_patch_points(patches, SPACING).expect("valid patches triangulate")
     }
 
     fn scene_with_steps() -> impl Strategy<Value = (Vec<Patch>, Vec<CapsuleStep>)> {
