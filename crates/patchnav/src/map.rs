@@ -11,7 +11,7 @@ use patch_core::{FromPatches, Patch, PatchMap, Point3};
 use patch_map::mapfile::read_header;
 use patch_map::{
     AnyMap, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap, PolygonMap,
-    RapierMap, TrimeshMap, load_any, planar_patches_from_mesh,
+    RapierMap, TrimeshMap, load_any, planar_patches_from_mesh, sample_patch_points,
 };
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
@@ -58,6 +58,11 @@ pub struct BuildArgs {
     /// The map file to write (conventionally `.pmap`).
     #[arg(long)]
     pub out: PathBuf,
+    /// For `--backend pointcloud` from a mesh or patch map: sample the patches every SPACING
+    /// metres (keep it below half the robot radius; see the point-cloud map's density
+    /// assumption).
+    #[arg(long)]
+    pub spacing: Option<f64>,
     #[command(flatten)]
     pub input_options: InputArgs,
 }
@@ -149,10 +154,19 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches("bbox6d")?)?, &args.out)?,
         BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches("trimesh")?)?, &args.out)?,
         BackendChoice::Rapier => save(&RapierMap::from_patches(patches("rapier")?)?, &args.out)?,
-        BackendChoice::Pointcloud => match &source {
-            Source::Points(points) => save(&PointCloudMap::from_points(points)?, &args.out)?,
-            Source::Patches(_) => bail!(
-                "{}: the pointcloud backend is built from a point cloud, not from patches",
+        BackendChoice::Pointcloud => match (&source, args.spacing) {
+            (Source::Points(points), None) => {
+                save(&PointCloudMap::from_points(points)?, &args.out)?
+            }
+            (Source::Points(_), Some(_)) => {
+                bail!("--spacing applies to patch inputs; a point cloud is used as it is")
+            }
+            (Source::Patches(patches), Some(spacing)) => {
+                let points = sample_patch_points(patches, spacing)?;
+                save(&PointCloudMap::from_points(&points)?, &args.out)?
+            }
+            (Source::Patches(_), None) => bail!(
+                "{}: the pointcloud backend needs a point cloud, or --spacing to sample the patches",
                 args.input.display()
             ),
         },

@@ -295,8 +295,26 @@ fn map_build_and_info_for_every_backend() {
             "--out",
             back.to_str().unwrap(),
         ]),
-        "pointcloud backend",
+        "--spacing",
     );
+    // With --spacing the patches are sampled: the 4 × 3 floor and the 4 × 2 wall at 0.1 m give
+    // at least 41 × 31 + 41 × 21 points.
+    let sampled = dir.path().join("sampled.pmap");
+    let o = patchnav(&[
+        "map",
+        "build",
+        obj.to_str().unwrap(),
+        "--backend",
+        "pointcloud",
+        "--spacing",
+        "0.1",
+        "--out",
+        sampled.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info = stdout(&patchnav(&["map", "info", sampled.to_str().unwrap()]));
+    let n: usize = info_field(&info, "points").parse().unwrap();
+    assert!(n >= 41 * 31 + 41 * 21, "{n} points");
 }
 
 #[test]
