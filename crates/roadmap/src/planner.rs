@@ -1,0 +1,232 @@
+//! The object-safe planner face, its outcome and counters, and the machinery RRT and PRM
+//! share (collision-check counting, start/goal validation, goal bookkeeping, paths).
+
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use petgraph::graph::{NodeIndex, UnGraph};
+
+use crate::space::{Goal, PlanningSpace, Problem};
+use crate::termination::{Progress, Termination};
+
+/// A roadmap: vertices are robot positions, an edge is a straight motion whose capsule of
+/// the robot radius was found free; its weight is its length.
+pub type Roadmap = UnGraph<Point3, Real>;
+
+/// How a `solve` ended: an outcome, not an error (OMPL's `PlannerStatus`).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum PlannerStatus {
+    /// Every goal is connected to the start ([`Planner::path_to`] returns a path for each).
+    Exact,
+    /// The termination stopped the run with some goal unreached; `gap` is the largest, over the
+    /// unreached goals, of the distance from the goal centre to the closest vertex connected
+    /// to the start.
+    Approximate {
+        /// That distance, in metres.
+        gap: Real,
+    },
+    /// The termination stopped the run with some goal unreached before any vertex was
+    /// connected to the start (nothing was explored).
+    Timeout,
+    /// The start is not finite, lies outside the space's bounds, or its sphere collides.
+    InvalidStart,
+    /// Some goal centre is not finite, lies outside the bounds or its sphere collides, or its
+    /// tolerance is not a finite non-negative number.
+    InvalidGoal,
+}
+
+/// What a planner has done in its last `solve` (the thesis counts iterations, vertices and
+/// collision checks, Fig. 6.9; OMPL's benchmark records the same).
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct PlannerCounters {
+    /// Samples drawn (= iterations).
+    pub samples: u64,
+    /// Vertices of the roadmap.
+    pub vertices: usize,
+    /// Edges of the roadmap.
+    pub edges: usize,
+    /// Capsule checks asked of the map, including the start and goal validity checks.
+    pub collision_checks: u64,
+    /// Wall-clock time spent inside those checks.
+    pub collision_time: Duration,
+}
+
+/// A planner behind a trait object (generic inside, `dyn` at the boundary: a benchmark
+/// harness holds `Box<dyn Planner + '_>`).
+///
+/// Every `solve` starts from scratch: the roadmap is cleared and the random stream re-seeded,
+/// so solving the same problem twice gives the same roadmap.
+pub trait Planner {
+    /// A short name for reports (`"rrt"`, `"prm"`).
+    fn name(&self) -> &'static str;
+
+    /// Builds a roadmap for `problem` until `stop` says so, and tells how it ended.
+    fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus;
+
+    /// The roadmap of the last `solve` (empty before the first and after
+    /// [`clear`](Planner::clear)). Node 0 is the start.
+    fn roadmap(&self) -> &Roadmap;
+
+    /// The path from the start to goal number `goal` of the last problem, or `None` if it is
+    /// unreached or out of range. It ends at the vertex that reached the goal (within the
+    /// goal's tolerance, or the goal centre itself after a direct goal step).
+    fn path_to(&self, goal: usize) -> Option<Vec<Point3>>;
+
+    /// The counters of the last `solve`.
+    fn counters(&self) -> PlannerCounters;
+
+    /// Forgets the roadmap, the goals reached and the counters.
+    fn clear(&mut self);
+}
+
+/// Capsule checks through the map, counted and timed.
+pub(crate) struct Checker<'a, M: ?Sized> {
+    map: &'a M,
+    radius: Real,
+    checks: u64,
+    time: Duration,
+}
+
+impl<'a, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Checker<'a, M> {
+    pub(crate) fn new(map: &'a M, radius: Real) -> Self {
+        Checker { map, radius, checks: 0, time: Duration::ZERO }
+    }
+
+    /// Whether the robot's capsule from `a` to `b` is free. A step that cannot be built
+    /// (non-finite points) counts as colliding.
+    pub(crate) fn free(&mut self, a: &Point3, b: &Point3) -> bool {
+        let Ok(step) = CapsuleStep::new(*a, *b, self.radius) else {
+            return false;
+        };
+        let t0 = Instant::now();
+        let free = self.map.is_step_free(&step);
+        self.time += t0.elapsed();
+        self.checks += 1;
+        free
+    }
+}
+
+/// The start and goal checks every planner makes before sampling.
+pub(crate) fn validate<M>(
+    problem: &Problem,
+    space: &PlanningSpace,
+    checker: &mut Checker<'_, M>,
+) -> Option<PlannerStatus>
+where
+    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    let bounds = space.bounds();
+    let valid = |p: &Point3, checker: &mut Checker<'_, M>| {
+        p.iter().all(|c| c.is_finite()) && bounds.contains(p) && checker.free(p, p)
+    };
+    if !valid(&problem.start, checker) {
+        return Some(PlannerStatus::InvalidStart);
+    }
+    for goal in &problem.goals {
+        let tolerance_ok = goal.tolerance.is_finite() && goal.tolerance >= 0.0;
+        if !(tolerance_ok && valid(&goal.center, checker)) {
+            return Some(PlannerStatus::InvalidGoal);
+        }
+    }
+    None
+}
+
+/// The shared state of a solve: the roadmap, which vertex reached each goal, the counters.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Solution {
+    pub(crate) graph: Roadmap,
+    pub(crate) goals: Vec<Goal>,
+    pub(crate) reached: Vec<Option<NodeIndex>>,
+    pub(crate) counters: PlannerCounters,
+}
+
+impl Solution {
+    pub(crate) fn reset(&mut self, goals: &[Goal]) {
+        self.graph.clear();
+        self.goals = goals.to_vec();
+        self.reached = vec![None; goals.len()];
+        self.counters = PlannerCounters::default();
+    }
+
+    pub(crate) fn goals_reached(&self) -> usize {
+        self.reached.iter().filter(|r| r.is_some()).count()
+    }
+
+    pub(crate) fn progress(&self, iterations: u64, started: Instant) -> Progress {
+        Progress {
+            iterations,
+            vertices: self.graph.node_count(),
+            goals_reached: self.goals_reached(),
+            goals_total: self.goals.len(),
+            elapsed: started.elapsed(),
+        }
+    }
+
+    pub(crate) fn finish(&mut self, samples: u64, checker: &Checker<'_, impl ?Sized>) {
+        self.counters.samples = samples;
+        self.counters.vertices = self.graph.node_count();
+        self.counters.edges = self.graph.edge_count();
+        self.counters.collision_checks = checker.checks;
+        self.counters.collision_time = checker.time;
+    }
+
+    /// The final status; `connected(v)` tells whether vertex `v` is connected to the start.
+    pub(crate) fn status(&self, connected: impl Fn(NodeIndex) -> bool) -> PlannerStatus {
+        if self.reached.iter().all(Option::is_some) {
+            return PlannerStatus::Exact;
+        }
+        let explored: Vec<Point3> =
+            self.graph.node_indices().filter(|&v| connected(v)).map(|v| self.graph[v]).collect();
+        if explored.len() <= 1 {
+            return PlannerStatus::Timeout;
+        }
+        let gap = self
+            .goals
+            .iter()
+            .zip(&self.reached)
+            .filter(|(_, r)| r.is_none())
+            .map(|(g, _)| {
+                explored.iter().map(|p| (p - g.center).norm()).fold(Real::INFINITY, Real::min)
+            })
+            .fold(0.0, Real::max);
+        PlannerStatus::Approximate { gap }
+    }
+
+    /// The path from node 0 to the vertex that reached `goal` (breadth-first: the roadmaps
+    /// are forests, so the path is unique).
+    pub(crate) fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
+        let target = (*self.reached.get(goal)?)?;
+        let start = NodeIndex::new(0);
+        let mut parent: Vec<Option<NodeIndex>> = vec![None; self.graph.node_count()];
+        let mut queue = VecDeque::from([start]);
+        parent[start.index()] = Some(start);
+        while let Some(v) = queue.pop_front() {
+            if v == target {
+                break;
+            }
+            for w in self.graph.neighbors(v) {
+                if parent[w.index()].is_none() {
+                    parent[w.index()] = Some(v);
+                    queue.push_back(w);
+                }
+            }
+        }
+        parent[target.index()]?;
+        let mut path = vec![self.graph[target]];
+        let mut v = target;
+        while v != start {
+            v = parent[v.index()]?;
+            path.push(self.graph[v]);
+        }
+        path.reverse();
+        Some(path)
+    }
+}
+
+/// A uniform sample in the box (a flat axis gives its one value).
+pub(crate) fn uniform(rng: &mut impl rand::Rng, space: &PlanningSpace) -> Point3 {
+    let b = space.bounds();
+    Point3::from(std::array::from_fn(|i| b.min[i] + (b.max[i] - b.min[i]) * rng.random::<Real>()))
+        .inf(&b.max)
+}
