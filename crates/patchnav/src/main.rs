@@ -6,6 +6,7 @@
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
+//! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner rrt|prm] [--seed K]
 //! ```
 //!
 //! Errors are printed as one line on standard error and the exit code is 1 (2 for usage errors,
@@ -19,6 +20,7 @@ mod convert;
 mod info;
 mod input;
 mod map;
+mod plan;
 mod progress;
 mod simulate;
 
@@ -56,6 +58,8 @@ enum Command {
     /// Build and inspect map files.
     #[command(subcommand)]
     Map(map::MapCommand),
+    /// Plan on a map file with RRT or PRM.
+    Plan(plan::PlanArgs),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +72,7 @@ fn main() -> ExitCode {
         }
         Command::Simulate(args) => simulate::run(&args, &progress),
         Command::Map(command) => map::run(&command, &progress),
+        Command::Plan(args) => plan::run(&args, &progress),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -124,7 +124,8 @@ fn load_source(input: &Path, options: &InputArgs, progress: &Progress) -> Result
     }
 }
 
-fn open_map(path: &Path) -> Result<AnyMap> {
+/// Reads a map file of any backend.
+pub fn open_map(path: &Path) -> Result<AnyMap> {
     let file = File::open(path).with_context(|| format!("opening {}", path.display()))?;
     load_any(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))
 }
@@ -178,6 +179,16 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         args.backend
     ));
     Ok(())
+}
+
+/// The bounding box of a map's patches or points.
+pub fn map_bounds(map: &AnyMap) -> Aabb {
+    match map {
+        AnyMap::PointCloud(m) => m.bounds(),
+        other => other
+            .patches()
+            .map_or(Aabb::EMPTY, |p| p.iter().fold(Aabb::EMPTY, |b, q| b.union(&q.bounds()))),
+    }
 }
 
 /// The text `map info` prints.

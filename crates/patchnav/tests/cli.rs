@@ -349,3 +349,85 @@ fn corrupt_map_files_are_one_line_errors() {
     assert_one_line_error(&patchnav(&["map", "info", bad.to_str().unwrap()]), "version 9");
     assert_one_line_error(&patchnav(&["map", "info", obj.to_str().unwrap()]), "not a patch map");
 }
+
+#[test]
+fn plan_reaches_goals_deterministically_and_writes_obj_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write_small_obj(dir.path());
+    let map = dir.path().join("room.pmap");
+    let o = patchnav(&[
+        "-q",
+        "map",
+        "build",
+        obj.to_str().unwrap(),
+        "--backend",
+        "bbox6d",
+        "--out",
+        map.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let roadmap = dir.path().join("roadmap.obj");
+    let path = dir.path().join("path.obj");
+    let plan = |seed: &str| {
+        patchnav(&[
+            "plan",
+            map.to_str().unwrap(),
+            "--start",
+            "0.5,2.5,1",
+            "--goal",
+            "3.5,2.5,1.5",
+            "--goal",
+            "3.5,0.5,0.5",
+            "--radius",
+            "0.2",
+            "--step",
+            "0.5",
+            "--seed",
+            seed,
+            "--roadmap-out",
+            roadmap.to_str().unwrap(),
+            "--path-out",
+            path.to_str().unwrap(),
+        ])
+    };
+    let first = plan("7");
+    assert!(first.status.success(), "{}", stderr(&first));
+    let text = stdout(&first);
+    assert_eq!(info_field(&text, "status"), "Exact", "{text}");
+    assert!(text.contains("goal 0 (3.50, 2.50, 1.50): reached"), "{text}");
+    assert!(text.contains("goal 1 (3.50, 0.50, 0.50): reached"), "{text}");
+    assert_eq!(stdout(&plan("7")), text, "same seed, same run");
+    let lines = std::fs::read_to_string(&path).unwrap();
+    assert!(lines.starts_with("v 0.5 2.5 1\n"), "{lines}");
+    assert_eq!(lines.lines().filter(|l| l.starts_with("l ")).count(), 1);
+    let graph = std::fs::read_to_string(&roadmap).unwrap();
+    let vertices = graph.lines().filter(|l| l.starts_with("v ")).count();
+    assert_eq!(vertices.to_string(), info_field(&text, "vertices"));
+
+    // A start inside the wall's radius is an outcome, not an error.
+    let o = patchnav(&[
+        "plan",
+        map.to_str().unwrap(),
+        "--start",
+        "2,0.1,1",
+        "--goal",
+        "3.5,2.5,1",
+        "--radius",
+        "0.2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(info_field(&stdout(&o), "status"), "InvalidStart");
+    // A malformed point is a usage error (exit code 2, clap's message).
+    let o = patchnav(&[
+        "plan",
+        map.to_str().unwrap(),
+        "--start",
+        "1,2",
+        "--goal",
+        "3,2,1",
+        "--radius",
+        "0.2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("is not three finite numbers x,y,z"), "{}", stderr(&o));
+}

@@ -1,0 +1,171 @@
+//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm ...`: one planning run on a
+//! map file, printing the status, the counters and the path, and writing the roadmap and the
+//! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
+
+use crate::progress::Progress;
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use patch_core::{Point3, Real};
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt,
+    RrtConfig,
+};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The planners `plan` offers.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PlannerChoice {
+    /// Rapidly-exploring random tree (thesis Algorithm 13), with the direct goal step.
+    Rrt,
+    /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
+    Prm,
+}
+
+/// Arguments of `patchnav plan`.
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// A map file written by `patchnav map build` (any backend).
+    pub map: PathBuf,
+    /// Start position `x,y,z` in metres.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub start: Point3,
+    /// A goal position `x,y,z` (repeat for several regions of interest).
+    #[arg(long = "goal", value_parser = parse_point, allow_hyphen_values = true, required = true)]
+    pub goals: Vec<Point3>,
+    /// How close a vertex must come to a goal, metres.
+    #[arg(long, default_value_t = 0.5)]
+    pub goal_tolerance: Real,
+    /// The planner.
+    #[arg(long, value_enum, default_value_t = PlannerChoice::Rrt)]
+    pub planner: PlannerChoice,
+    /// Robot radius (the capsule radius of every step), metres.
+    #[arg(long)]
+    pub radius: Real,
+    /// Longest tree edge (RRT), metres.
+    #[arg(long, default_value_t = 1.0)]
+    pub step: Real,
+    /// Seed of the planner's random samples.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Iteration budget.
+    #[arg(long, default_value_t = 10_000)]
+    pub iterations: u64,
+    /// Keep growing after every goal is reached (the thesis's fixed-K runs) instead of stopping.
+    #[arg(long)]
+    pub explore: bool,
+    /// Write the roadmap as OBJ polylines.
+    #[arg(long)]
+    pub roadmap_out: Option<PathBuf>,
+    /// Write the path to the first goal as an OBJ polyline.
+    #[arg(long)]
+    pub path_out: Option<PathBuf>,
+}
+
+fn parse_point(text: &str) -> Result<Point3, String> {
+    let v: Vec<Real> = text
+        .split(',')
+        .map(|s| s.trim().parse::<Real>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}` is not x,y,z: {e}"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Point3::new(x, y, z)),
+        _ => Err(format!("`{text}` is not three finite numbers x,y,z")),
+    }
+}
+
+/// Runs `patchnav plan`.
+pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
+    let map = crate::map::open_map(&args.map)?;
+    let bounds = crate::map::map_bounds(&map);
+    if bounds.is_empty() {
+        bail!("{}: the map is empty, so it has no bounds to sample in", args.map.display());
+    }
+    let space = PlanningSpace::new(bounds, args.radius, args.step)
+        .context("--radius and --step must be positive numbers of metres")?;
+    let problem = Problem {
+        start: args.start,
+        goals: args
+            .goals
+            .iter()
+            .map(|&center| Goal { center, tolerance: args.goal_tolerance })
+            .collect(),
+    };
+    let mut planner: Box<dyn Planner + '_> = match args.planner {
+        PlannerChoice::Rrt => Box::new(Rrt::new(&map, space, RrtConfig::lesum(None), args.seed)),
+        PlannerChoice::Prm => Box::new(Prm::new(&map, space, PrmConfig::thesis(), args.seed)),
+    };
+    let spinner = progress.spinner("planning");
+    let status = if args.explore {
+        planner.solve(&problem, &mut MaxIterations(args.iterations))
+    } else {
+        planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(args.iterations)))
+    };
+    spinner.finish_and_clear();
+    let c = planner.counters();
+    let mut out = String::new();
+    writeln!(out, "planner:          {} on a `{}` map", planner.name(), map.backend())?;
+    writeln!(out, "status:           {status:?}")?;
+    writeln!(out, "samples:          {}", c.samples)?;
+    writeln!(out, "vertices:         {}", c.vertices)?;
+    writeln!(out, "edges:            {}", c.edges)?;
+    writeln!(
+        out,
+        "collision checks: {} ({:.3} s)",
+        c.collision_checks,
+        c.collision_time.as_secs_f64()
+    )?;
+    for (i, goal) in problem.goals.iter().enumerate() {
+        match planner.path_to(i) {
+            Some(path) => {
+                let length: Real = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+                writeln!(
+                    out,
+                    "goal {i} ({:.2}, {:.2}, {:.2}): reached, path of {} vertices, {length:.3} m",
+                    goal.center.x,
+                    goal.center.y,
+                    goal.center.z,
+                    path.len()
+                )?;
+            }
+            None => writeln!(
+                out,
+                "goal {i} ({:.2}, {:.2}, {:.2}): not reached",
+                goal.center.x, goal.center.y, goal.center.z
+            )?,
+        }
+    }
+    if let Some(file) = &args.roadmap_out {
+        let graph = planner.roadmap();
+        let points: Vec<Point3> = graph.node_weights().copied().collect();
+        let lines = graph
+            .edge_indices()
+            .filter_map(|e| graph.edge_endpoints(e))
+            .map(|(a, b)| vec![a.index(), b.index()]);
+        write_obj_lines(file, &points, lines)?;
+    }
+    if let Some(file) = &args.path_out {
+        let path = planner.path_to(0).unwrap_or_default();
+        let line = (!path.is_empty()).then(|| (0..path.len()).collect());
+        write_obj_lines(file, &path, line.into_iter())?;
+    }
+    progress.say(out.trim_end());
+    Ok(())
+}
+
+/// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).
+fn write_obj_lines(
+    path: &Path,
+    points: &[Point3],
+    lines: impl Iterator<Item = Vec<usize>>,
+) -> Result<()> {
+    let mut text = String::new();
+    for p in points {
+        writeln!(text, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for line in lines {
+        let ids: Vec<String> = line.iter().map(|i| (i + 1).to_string()).collect();
+        writeln!(text, "l {}", ids.join(" "))?;
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
