@@ -417,6 +417,12 @@ impl From<TrimeshPatch> for RawTrimeshPatch {
 }
 
 impl TrimeshPatch {
+    /// The heap bytes this patch owns: its vertex and triangle buffers, by capacity.
+    pub fn heap_bytes(&self) -> usize {
+        self.vertices.capacity() * std::mem::size_of::<Point3>()
+            + self.triangles.capacity() * std::mem::size_of::<[u32; 3]>()
+    }
+
     /// Validates and builds the mesh.
     ///
     /// # Errors
@@ -446,6 +452,9 @@ impl TrimeshPatch {
                 return Err(PatchError::DegenerateTriangle { triangle, area });
             }
         }
+        let (mut vertices, mut triangles) = (vertices, triangles);
+        vertices.shrink_to_fit();
+        triangles.shrink_to_fit();
         Ok(TrimeshPatch { vertices, triangles })
     }
 
@@ -580,6 +589,15 @@ impl From<TrimeshPatch> for Patch {
 }
 
 impl Patch {
+    /// The heap bytes this patch owns (its polygon rings or mesh buffers, by capacity); the
+    /// patch value itself is not included.
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            Patch::Planar(p) => p.polygon().heap_bytes(),
+            Patch::Trimesh(m) => m.heap_bytes(),
+        }
+    }
+
     /// Which kind of patch this is.
     pub fn kind(&self) -> PatchKind {
         match self {

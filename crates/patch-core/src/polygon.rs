@@ -51,6 +51,11 @@ pub struct Ring {
 }
 
 impl Ring {
+    /// The heap bytes this ring owns (its vertex buffer, by capacity).
+    pub fn heap_bytes(&self) -> usize {
+        self.points.capacity() * std::mem::size_of::<Point2>()
+    }
+
     /// The vertices, in ring order (the closing edge from the last to the first is implied).
     pub fn points(&self) -> &[Point2] {
         &self.points
@@ -124,6 +129,14 @@ impl From<Polygon> for RawPolygon {
 
 /// # Construction
 impl Polygon {
+    /// The heap bytes this polygon owns: every ring's vertex buffer and the hole list, by
+    /// capacity.
+    pub fn heap_bytes(&self) -> usize {
+        self.outer.heap_bytes()
+            + self.holes.capacity() * std::mem::size_of::<Ring>()
+            + self.holes.iter().map(Ring::heap_bytes).sum::<usize>()
+    }
+
     /// Validates the rings and builds the polygon; see [`Polygon`] for what is checked.
     /// Rings are reoriented (outer counter-clockwise, holes clockwise) as needed.
     ///
@@ -166,10 +179,14 @@ impl Polygon {
             if is_ccw(&points) != want_ccw {
                 points.reverse();
             }
+            // Tight buffers: maps hold many patches, and their memory is reported exactly.
+            points.shrink_to_fit();
             Ring { points }
         });
         let outer = rings.next().expect("the outer ring is always present");
-        Ok(Polygon { outer, holes: rings.collect() })
+        let mut holes: Vec<Ring> = rings.collect();
+        holes.shrink_to_fit();
+        Ok(Polygon { outer, holes })
     }
 
     /// The axis-aligned rectangle spanned by two opposite corners, without holes.

@@ -61,23 +61,11 @@ pub trait MemoryUsage {
     fn memory_bytes(&self) -> usize;
 }
 
-/// The heap bytes of one patch: its vertex, hole and triangle buffers.
-///
-/// `patch-core` does not expose the capacities of a patch's buffers, so their lengths are
-/// counted: exact when the buffers have no spare capacity, a lower bound otherwise. Polygon rings count `size_of::<Point2>()` per
-/// vertex, the hole list `size_of::<Ring>()` per hole, meshes `size_of::<Point3>()` per vertex
-/// and 12 bytes per triangle. The patch value itself (the enum with its transform and
-/// covariance) lives in the map's patch list and is counted there.
+/// The heap bytes of one patch: its vertex, hole and triangle buffers, by capacity
+/// ([`Patch::heap_bytes`]). The patch value itself (the enum with its transform and covariance)
+/// lives in the map's patch list and is counted there.
 pub fn patch_memory_bytes(patch: &Patch) -> usize {
-    use std::mem::{size_of, size_of_val};
-    match patch {
-        // Every ring's vertices (`num_vertices` counts all rings), and the list of holes.
-        Patch::Planar(p) => {
-            let polygon = p.polygon();
-            polygon.num_vertices() * size_of::<Point2>() + size_of_val(polygon.holes())
-        }
-        Patch::Trimesh(m) => size_of_val(m.vertices()) + size_of_val(m.triangles()),
-    }
+    patch.heap_bytes()
 }
 
 /// The heap bytes of a patch list: its buffer (by capacity) and every patch's own buffers

@@ -4,7 +4,9 @@
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_core::{
+    CapsuleStep, Point3, Real, SpecificStepIntersector, StepHit, UnspecificStepIntersector,
+};
 use petgraph::graph::{NodeIndex, UnGraph};
 
 use crate::space::{Goal, PlanningSpace, Problem};
@@ -104,6 +106,36 @@ impl<'a, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Checker<'a, M> {
         self.time += t0.elapsed();
         self.checks += 1;
         free
+    }
+}
+
+/// What a specific capsule check found.
+pub(crate) enum Contact {
+    /// The step is free.
+    Free,
+    /// The step first touches the map here.
+    Hit(StepHit),
+    /// The step could not be built (non-finite points): treated as colliding.
+    Invalid,
+}
+
+impl<'a, M: SpecificStepIntersector<CapsuleStep> + ?Sized> Checker<'a, M> {
+    /// The first contact of the robot's capsule from `a` to `b`, counted and timed as one
+    /// collision check.
+    pub(crate) fn first_hit(&mut self, a: &Point3, b: &Point3) -> Contact {
+        let Ok(step) = CapsuleStep::new(*a, *b, self.radius) else {
+            return Contact::Invalid;
+        };
+        let t0 = Instant::now();
+        let hit = self.map.first_hit(&step);
+        self.time += t0.elapsed();
+        self.checks += 1;
+        hit.map_or(Contact::Free, Contact::Hit)
+    }
+
+    /// The map (for patch look-ups).
+    pub(crate) fn map(&self) -> &'a M {
+        self.map
     }
 }
 

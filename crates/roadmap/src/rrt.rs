@@ -112,7 +112,12 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
-        solve_rrt(self.map, &self.space, &self.config, self.seed, problem, stop, &mut self.solution)
+        let bounds = self.space.bounds();
+        let extend = |checker: &mut Checker<'_, M>, x_near: &Point3, x_new: &Point3| {
+            (bounds.contains(x_new) && checker.free(x_near, x_new)).then_some(*x_new)
+        };
+        let solution = &mut self.solution;
+        solve_rrt(self.map, &self.space, &self.config, self.seed, problem, stop, solution, extend)
     }
 
     fn roadmap(&self) -> &Roadmap {
@@ -132,14 +137,19 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
     }
 }
 
-fn solve_rrt<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
-    map: &M,
+/// The RRT loop shared by [`Rrt`] and the Evasion RRT: `extend(checker, x_near, x_new)`
+/// returns the vertex to add with an edge to `x_near` (`x_new` itself for the plain RRT, a
+/// shifted point for the Evasion RRT), or `None` if the extension is Trapped.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+    map: &'m M,
     space: &PlanningSpace,
     config: &RrtConfig,
     seed: u64,
     problem: &Problem,
     stop: &mut dyn Termination,
     solution: &mut Solution,
+    mut extend: impl FnMut(&mut Checker<'m, M>, &Point3, &Point3) -> Option<Point3>,
 ) -> PlannerStatus {
     let started = Instant::now();
     solution.reset(&problem.goals);
@@ -164,9 +174,9 @@ fn solve_rrt<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
         let x_near = solution.graph[NodeIndex::new(near.index)];
         let length = space.max_step().min(near.distance);
         let x_new = x_near + (x - x_near) * (length / near.distance);
-        if !space.bounds().contains(&x_new) || !checker.free(&x_near, &x_new) {
+        let Some(x_new) = extend(&mut checker, &x_near, &x_new) else {
             continue;
-        }
+        };
         let v = solution.graph.add_node(x_new);
         solution.graph.add_edge(NodeIndex::new(near.index), v, (x_new - x_near).norm());
         nn.add(x_new);
