@@ -21,8 +21,7 @@
 use std::io::{Read, Write};
 
 use patch_core::{
-    CapsuleStep, FromPatches, LineStep, Patch, PatchMap, Point2, Point3, Real,
-    UnspecificStepIntersector,
+    CapsuleStep, FromPatches, LineStep, Patch, PatchMap, Point3, Real, UnspecificStepIntersector,
 };
 
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
@@ -310,7 +309,7 @@ pub fn load_any(mut reader: impl Read) -> Result<AnyMap, MapFileError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use patch_core::{Isometry3, PlanarPatch, Polygon, TrimeshPatch};
+    use patch_core::{Isometry3, PlanarPatch, Point2, Polygon, TrimeshPatch};
 
     #[test]
     fn patch_bytes_follow_the_buffers() {

@@ -63,6 +63,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod evasion;
+pub mod metrics;
 mod nn;
 mod planner;
 mod prm;
@@ -70,6 +72,8 @@ mod rrt;
 mod space;
 mod termination;
 
+pub use evasion::{EvasionRrt, EvasionRrtConfig};
+pub use metrics::PathMetrics;
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
 pub use prm::{Prm, PrmConfig};
