@@ -1,6 +1,25 @@
-//! Roadmap planners on patch maps: the RRT and the PRM of the thesis (Poppinga 2010,
-//! "Towards Autonomous Navigation for Robots with 3D Sensors", §5.5 and §6.1, Algorithms 13
-//! and 14), generic over the collision capabilities of `patch-core` and never over a backend.
+//! Roadmap planners on patch maps: the RRT, the PRM and the Evasion RRT of the thesis
+//! (Poppinga 2010, "Towards Autonomous Navigation for Robots with 3D Sensors", §5.5 and §6.1,
+//! Algorithms 13, 14 and 11), RRT-Connect as a baseline from the literature, and the path
+//! metrics of the thesis's benchmark ([`metrics`]); generic over the collision capabilities
+//! of `patch-core` and never over a backend.
+//!
+//! # Planners and the capabilities they need (thesis Table 5.2)
+//!
+//! | planner | capability of the map | here |
+//! |---|---|---|
+//! | RRT (Alg. 13) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Rrt`] |
+//! | PRM (Alg. 14) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] |
+//! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector<CapsuleStep>`] | [`EvasionRrt`] |
+//! | MA RRT, MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | not yet |
+//! | RRT-Connect (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtConnect`] |
+//!
+//! A planner states its capability as a trait bound, so a map without it is rejected at
+//! compile time.
+//!
+//! [`UnspecificStepIntersector<CapsuleStep>`]: patch_core::UnspecificStepIntersector
+//! [`SpecificStepIntersector<CapsuleStep>`]: patch_core::SpecificStepIntersector
+//! [`ProximityQuery`]: patch_core::ProximityQuery
 //!
 //! # Design (OMPL's separation)
 //! * [`PlanningSpace`]: the sampling box, the robot's sphere radius, the RRT step (validated;
@@ -11,9 +30,9 @@
 //! * [`Planner`]: the object-safe face, `solve` → [`PlannerStatus`] (an outcome, not an
 //!   error), the [`Roadmap`] (a petgraph graph, edge weight = length), paths and
 //!   [`PlannerCounters`] (samples, vertices, edges, collision checks and their time).
-//! * [`Rrt`] and [`Prm`] are generic over `M: UnspecificStepIntersector<CapsuleStep>`, the one
-//!   capability they need (thesis Table 5.2); configs ([`RrtConfig`], [`PrmConfig`]) have no
-//!   `Default` but named constructors with the thesis's choices.
+//! * Each planner is generic over the one capability it needs (table above); configs
+//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`]) have no `Default` but named
+//!   constructors with the thesis's choices, or documented ones where the thesis gives none.
 //!
 //! Runs are deterministic: a planner takes a seed (ChaCha8), every `solve` starts from it,
 //! and nearest-neighbour queries ([`KdNeighbors`], checked against the linear scan
@@ -31,13 +50,19 @@
 //! * PRM components by union–find; no vertex validity check, no edge-length limit by default
 //!   (spec §4); `N` is a parameter, 6 in [`PrmConfig::thesis`] (§7.4).
 //! * The sampling box is the caller's (§7.10, §7.18: the thesis uses the box of all patches).
+//! * Evasion RRT: the printed Algorithm 11 is broken (§7.14); [`EvasionRrt`] implements the
+//!   spec's repair (shift `x_new` by `l_ev · unit(u × n_p)` while the hit patch stays the same
+//!   planar patch, at most `E` times, add only if free). The thesis gives neither `l_ev` nor
+//!   `E`; [`EvasionRrtConfig::for_space`] documents this crate's values.
+//! * Path metrics (§5.5.4, Tables 5.5–5.11): the thesis does not define its quartile; see
+//!   [`metrics`] for the method used and the treatment of straight and repeated vertices.
 //!
 //! # Not yet here
-//! Evasion RRT (Algorithm 11), the medial-axis planners (MA RRT, MA PRM, Algorithm 12),
-//! RRT-Connect, RRT*, PRM*, lazy PRM, path smoothing, path and roadmap metrics, the explored
-//! volume, the thesis's experiments, benchmarks, and a choice of nearest-neighbour structure
-//! per planner (both use [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL
-//! k-d tree for PRM, §6.1).
+//! The medial-axis planners (MA RRT, MA PRM, Algorithm 12), RRT*, PRM*, lazy PRM, path
+//! smoothing, roadmap metrics (only path metrics exist), the explored volume, the thesis's
+//! experiments, benchmarks, and a choice of nearest-neighbour structure per planner (all use
+//! [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL k-d tree for PRM, §6.1).
+//! [`RrtConnect`] handles at most one goal.
 //!
 //! # Example
 //! ```
@@ -63,6 +88,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod connect;
 mod evasion;
 pub mod metrics;
 mod nn;
@@ -72,6 +98,7 @@ mod rrt;
 mod space;
 mod termination;
 
+pub use connect::RrtConnect;
 pub use evasion::{EvasionRrt, EvasionRrtConfig};
 pub use metrics::PathMetrics;
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};

@@ -1,4 +1,4 @@
-//! The object-safe planner face, its outcome and counters, and the machinery RRT and PRM
+//! The object-safe planner face, its outcome and counters, and the machinery the planners
 //! share (collision-check counting, start/goal validation, goal bookkeeping, paths).
 
 use std::collections::VecDeque;
@@ -48,7 +48,8 @@ pub struct PlannerCounters {
     pub vertices: usize,
     /// Edges of the roadmap.
     pub edges: usize,
-    /// Capsule checks asked of the map, including the start and goal validity checks.
+    /// Capsule checks asked of the map (unspecific or specific), including the start and goal
+    /// validity checks.
     pub collision_checks: u64,
     /// Wall-clock time spent inside those checks.
     pub collision_time: Duration,

@@ -1,0 +1,210 @@
+//! RRT-Connect on the brute-force reference map: outcomes, determinism, and every edge
+//! re-checked free.
+
+use patch_core::conformance::SceneKind;
+use patch_core::conformance::strategies;
+use patch_core::{
+    Aabb, BruteForceMap, CapsuleStep, Counted, FromPatches, PlanarPatch, Point3, Real,
+    UnspecificStepIntersector,
+};
+use petgraph::algo::is_cyclic_undirected;
+use petgraph::visit::EdgeRef;
+use proptest::prelude::*;
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlannerStatus, PlanningSpace, Problem,
+    Roadmap, RrtConnect, Termination,
+};
+
+const RADIUS: Real = 0.2;
+
+fn space(max_step: Real) -> PlanningSpace {
+    let room = Aabb::new(Point3::origin(), Point3::new(6.0, 4.0, 2.5));
+    PlanningSpace::new(room, RADIUS, max_step).unwrap()
+}
+
+/// A wall at x = 3 across the room with a door off the straight line start → goal.
+fn wall_with_door() -> BruteForceMap {
+    let x = 3.0;
+    let outer = [
+        Point3::new(x, 0.0, 0.0),
+        Point3::new(x, 4.0, 0.0),
+        Point3::new(x, 4.0, 2.5),
+        Point3::new(x, 0.0, 2.5),
+    ];
+    let hole = vec![
+        Point3::new(x, 0.5, 0.5),
+        Point3::new(x, 1.5, 0.5),
+        Point3::new(x, 1.5, 2.0),
+        Point3::new(x, 0.5, 2.0),
+    ];
+    let wall = PlanarPatch::from_world_polygon(&outer, &[hole], 1e-9).unwrap();
+    BruteForceMap::from_patches([wall.into()]).unwrap()
+}
+
+fn across() -> Problem {
+    Problem {
+        start: Point3::new(1.0, 2.0, 1.25),
+        goals: vec![Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.0 }],
+    }
+}
+
+fn until_solved(k: u64) -> AnyOf<GoalReached, MaxIterations> {
+    AnyOf(GoalReached, MaxIterations(k))
+}
+
+fn assert_all_free(map: &BruteForceMap, planner: &dyn Planner) {
+    let graph = planner.roadmap();
+    for e in graph.edge_references() {
+        let (a, b) = (graph[e.source()], graph[e.target()]);
+        let step = CapsuleStep::new(a, b, RADIUS).unwrap();
+        assert!(map.is_step_free(&step), "roadmap edge {a} → {b} collides");
+        assert!((e.weight() - (b - a).norm()).abs() < 1e-12, "edge weight is its length");
+    }
+    if let Some(path) = planner.path_to(0) {
+        for w in path.windows(2) {
+            let step = CapsuleStep::new(w[0], w[1], RADIUS).unwrap();
+            assert!(map.is_step_free(&step), "path edge {} → {} collides", w[0], w[1]);
+        }
+    }
+}
+
+fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
+    let nodes = a.node_weights().eq(b.node_weights());
+    let edges = a
+        .edge_references()
+        .map(|e| (e.source(), e.target(), *e.weight()))
+        .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
+    nodes && edges
+}
+
+#[test]
+fn joins_the_trees_across_an_empty_room_and_through_the_door() {
+    let problem = across();
+    for map in [BruteForceMap::new(), wall_with_door()] {
+        for seed in 0..3 {
+            let mut p = RrtConnect::new(&map, space(0.5), seed);
+            assert_eq!(p.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
+            let path = p.path_to(0).unwrap();
+            assert_eq!(path[0], problem.start);
+            assert_eq!(path.last(), Some(&problem.goals[0].center));
+            assert!(path.windows(2).all(|w| (w[1] - w[0]).norm() <= 0.5 + 1e-12));
+            assert_all_free(&map, &p);
+            assert!(!is_cyclic_undirected(p.roadmap()));
+            assert_eq!(p.roadmap().edge_count(), p.roadmap().node_count() - 1, "one tree");
+        }
+    }
+    // The empty room needs only a few iterations: the first connection attempt succeeds.
+    let map = BruteForceMap::new();
+    let mut p = RrtConnect::new(&map, space(0.5), 0);
+    assert_eq!(p.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
+    assert!(p.counters().samples <= 3, "{} samples", p.counters().samples);
+}
+
+#[test]
+fn goals_start_and_termination() {
+    let map = wall_with_door();
+    let problem = across();
+    let mut p = RrtConnect::new(&map, space(0.5), 1);
+    assert_eq!(p.name(), "rrt-connect");
+    let two = Problem { goals: vec![problem.goals[0]; 2], ..problem.clone() };
+    assert_eq!(p.solve(&two, &mut MaxIterations(10)), PlannerStatus::InvalidGoal);
+    let bad_start = Problem { start: Point3::new(2.9, 3.0, 1.25), ..problem.clone() };
+    assert_eq!(p.solve(&bad_start, &mut MaxIterations(10)), PlannerStatus::InvalidStart);
+    assert_eq!(p.roadmap().node_count(), 0);
+    assert_eq!(p.solve(&problem, &mut MaxIterations(0)), PlannerStatus::Timeout);
+    assert_eq!(p.roadmap().node_count(), 2, "the start and the goal root");
+    if let PlannerStatus::Approximate { gap } = p.solve(&problem, &mut MaxIterations(5)) {
+        let closest = p
+            .roadmap()
+            .node_weights()
+            .skip(2)
+            .chain([problem.start].iter())
+            .map(|q| (q - problem.goals[0].center).norm())
+            .fold(Real::INFINITY, Real::min);
+        assert!(gap >= closest && gap <= 4.0);
+    }
+    // A goal within tolerance of the start: reached before any sample.
+    let trivial = Problem {
+        start: problem.start,
+        goals: vec![Goal {
+            center: problem.start + patch_core::Vector3::x() * 0.1,
+            tolerance: 0.2,
+        }],
+    };
+    assert_eq!(p.solve(&trivial, &mut until_solved(100)), PlannerStatus::Exact);
+    assert_eq!(p.path_to(0).unwrap(), vec![problem.start]);
+    // No goal: the start tree grows alone.
+    let none = Problem { start: problem.start, goals: vec![] };
+    assert_eq!(p.solve(&none, &mut MaxIterations(50)), PlannerStatus::Exact);
+    assert_eq!(p.counters().samples, 50);
+    assert_eq!(p.roadmap().edge_count(), p.roadmap().node_count() - 1);
+    p.clear();
+    assert_eq!(p.roadmap().node_count(), 0);
+    assert!(p.path_to(0).is_none());
+}
+
+/// A termination that records what it was shown.
+struct Recorder(Vec<u64>, u64);
+
+impl Termination for Recorder {
+    fn should_stop(&mut self, progress: &roadmap::Progress) -> bool {
+        self.0.push(progress.iterations);
+        progress.iterations >= self.1
+    }
+}
+
+#[test]
+fn determinism_counters_and_termination() {
+    let counted = Counted::new(wall_with_door());
+    let problem = across();
+    let run = |seed: u64| {
+        counted.reset_counts();
+        let mut p = RrtConnect::new(&counted, space(0.5), seed);
+        let mut rec = Recorder(Vec::new(), 300);
+        p.solve(&problem, &mut rec);
+        assert_eq!(rec.0, (0..=300).collect::<Vec<_>>());
+        assert_eq!(p.counters().collision_checks, counted.counts().is_step_free);
+        assert_eq!(p.counters().samples, 300);
+        let first = p.roadmap().clone();
+        p.solve(&problem, &mut MaxIterations(300));
+        assert!(same_roadmap(&first, p.roadmap()), "a second solve repeats the first");
+        first
+    };
+    let (a, b, c) = (run(5), run(5), run(6));
+    assert!(same_roadmap(&a, &b));
+    assert!(!same_roadmap(&a, &c));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+
+    #[test]
+    fn every_edge_is_free_on_random_scenes(
+        patches in strategies::scene(SceneKind::Mixed, 0..6),
+        start in strategies::point3(strategies::scene_bounds()),
+        goal in strategies::point3(strategies::scene_bounds()),
+        tolerance in 0.0..0.5f64,
+        seed in any::<u64>(),
+    ) {
+        let map = BruteForceMap::from_patches(patches).unwrap();
+        let space = PlanningSpace::new(strategies::scene_bounds(), RADIUS, 0.8).unwrap();
+        let problem = Problem { start, goals: vec![Goal { center: goal, tolerance }] };
+        let mut p = RrtConnect::new(&map, space, seed);
+        let status = p.solve(&problem, &mut MaxIterations(60));
+        assert_all_free(&map, &p);
+        let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
+        prop_assert_eq!(status == PlannerStatus::InvalidStart, !sphere_free(start));
+        if sphere_free(start) {
+            prop_assert_eq!(status == PlannerStatus::InvalidGoal, !sphere_free(goal));
+        }
+        prop_assert_eq!(status == PlannerStatus::Exact, p.path_to(0).is_some());
+        if let Some(path) = p.path_to(0) {
+            prop_assert_eq!(path[0], start);
+            prop_assert!((path.last().unwrap() - goal).norm() <= tolerance + 1e-12);
+        }
+        let graph = p.roadmap();
+        prop_assert!(!is_cyclic_undirected(graph));
+        prop_assert!(graph.edge_references().all(|e| *e.weight() <= 0.8 + 1e-12));
+        prop_assert!(graph.node_weights().all(|q| space.bounds().contains(q)));
+    }
+}
