@@ -1,4 +1,4 @@
-//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm ...`: one planning run on a
+//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|rrt-connect|evasion-rrt ...`: one planning run on a
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
 //! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
 
@@ -6,9 +6,10 @@ use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
+use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt,
-    RrtConfig,
+    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaxIterations, PathMetrics, Planner,
+    PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig, RrtConnect,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -20,6 +21,10 @@ pub enum PlannerChoice {
     Rrt,
     /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
     Prm,
+    /// RRT-Connect (Kuffner and LaValle 2000), one goal.
+    RrtConnect,
+    /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
+    EvasionRrt,
 }
 
 /// Arguments of `patchnav plan`.
@@ -94,6 +99,13 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     let mut planner: Box<dyn Planner + '_> = match args.planner {
         PlannerChoice::Rrt => Box::new(Rrt::new(&map, space, RrtConfig::lesum(None), args.seed)),
         PlannerChoice::Prm => Box::new(Prm::new(&map, space, PrmConfig::thesis(), args.seed)),
+        PlannerChoice::RrtConnect => {
+            if problem.goals.len() != 1 {
+                bail!("rrt-connect plans to exactly one --goal");
+            }
+            Box::new(RrtConnect::new(&map, space, args.seed))
+        }
+        PlannerChoice::EvasionRrt => evasion_planner(&map, space, args.seed)?,
     };
     let spinner = progress.spinner("planning");
     let status = if args.explore {
@@ -118,14 +130,19 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     for (i, goal) in problem.goals.iter().enumerate() {
         match planner.path_to(i) {
             Some(path) => {
-                let length: Real = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+                let m = PathMetrics::of(&path);
                 writeln!(
                     out,
-                    "goal {i} ({:.2}, {:.2}, {:.2}): reached, path of {} vertices, {length:.3} m",
+                    "goal {i} ({:.2}, {:.2}, {:.2}): reached, path of {} vertices, {:.3} m, \
+                     {} turns ({} steep), curviness {:.1}°",
                     goal.center.x,
                     goal.center.y,
                     goal.center.z,
-                    path.len()
+                    path.len(),
+                    m.length,
+                    m.turns,
+                    m.steep_turns,
+                    m.curviness.to_degrees()
                 )?;
             }
             None => writeln!(
@@ -151,6 +168,22 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     }
     progress.say(out.trim_end());
     Ok(())
+}
+
+/// The Evasion RRT on the concrete backend of `map` (it needs specific step hits, which a
+/// point-cloud map cannot give: thesis Table 5.2).
+fn evasion_planner(map: &AnyMap, space: PlanningSpace, seed: u64) -> Result<Box<dyn Planner + '_>> {
+    let config = EvasionRrtConfig::for_space(&space);
+    Ok(match map {
+        AnyMap::Polygon(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
+        AnyMap::BBox6d(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
+        AnyMap::Trimesh(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
+        AnyMap::Rapier(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
+        other => bail!(
+            "evasion-rrt needs a map that reports which patch a step hits; a `{}` map cannot",
+            other.backend()
+        ),
+    })
 }
 
 /// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).

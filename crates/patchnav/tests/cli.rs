@@ -431,3 +431,43 @@ fn plan_reaches_goals_deterministically_and_writes_obj_lines() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("is not three finite numbers x,y,z"), "{}", stderr(&o));
 }
+
+#[test]
+fn plan_offers_rrt_connect_and_evasion_rrt_where_the_map_allows() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write_small_obj(dir.path());
+    let map = dir.path().join("room.pmap");
+    let cloud = dir.path().join("cloud.pmap");
+    for (backend, out, extra) in [("trimesh", &map, None), ("pointcloud", &cloud, Some("0.05"))] {
+        let mut args = vec!["-q", "map", "build", obj.to_str().unwrap(), "--backend", backend];
+        if let Some(spacing) = extra {
+            args.extend(["--spacing", spacing]);
+        }
+        args.extend(["--out", out.to_str().unwrap()]);
+        let o = patchnav(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let plan = |map: &Path, planner: &str, goals: &[&str]| {
+        let mut args =
+            vec!["plan", map.to_str().unwrap(), "--start", "0.5,2.5,1", "--radius", "0.2"];
+        for g in goals {
+            args.extend(["--goal", g]);
+        }
+        args.extend(["--step", "0.5", "--planner", planner]);
+        patchnav(&args)
+    };
+    for planner in ["rrt-connect", "evasion-rrt", "prm"] {
+        let o = plan(&map, planner, &["3.5,2.5,1.5"]);
+        assert!(o.status.success(), "{planner}: {}", stderr(&o));
+        assert_eq!(info_field(&stdout(&o), "status"), "Exact", "{planner}: {}", stdout(&o));
+        assert!(stdout(&o).contains("curviness"), "{}", stdout(&o));
+    }
+    assert_one_line_error(
+        &plan(&map, "rrt-connect", &["3.5,2.5,1.5", "3.5,0.5,0.5"]),
+        "exactly one --goal",
+    );
+    assert_one_line_error(&plan(&cloud, "evasion-rrt", &["3.5,2.5,1.5"]), "`pointcloud` map");
+    let o = plan(&cloud, "rrt", &["3.5,2.5,1.5"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(info_field(&stdout(&o), "status"), "Exact", "{}", stdout(&o));
+}
