@@ -6,7 +6,8 @@
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
-//! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner rrt|prm] [--seed K]
+//! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]
+//! patchnav plan --problem P.json --backend B --planner X --mode explore|solve|roi
 //! ```
 //!
 //! Errors are printed as one line on standard error and the exit code is 1 (2 for usage errors,
@@ -21,6 +22,7 @@ mod info;
 mod input;
 mod map;
 mod plan;
+mod problem;
 mod progress;
 mod simulate;
 

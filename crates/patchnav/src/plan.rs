@@ -27,44 +27,48 @@ pub enum PlannerChoice {
     EvasionRrt,
 }
 
-/// Arguments of `patchnav plan`.
+/// Arguments of `patchnav plan`: either one run on a map file (`MAP --start --goal --radius`),
+/// or the runs of a shared planning problem (`--problem P.json --backend B --mode M`).
 #[derive(Args, Debug)]
 pub struct PlanArgs {
     /// A map file written by `patchnav map build` (any backend).
-    pub map: PathBuf,
+    #[arg(required_unless_present = "problem", conflicts_with = "problem")]
+    pub map: Option<PathBuf>,
     /// Start position `x,y,z` in metres.
-    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
-    pub start: Point3,
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true, required_unless_present = "problem", conflicts_with = "problem")]
+    pub start: Option<Point3>,
     /// A goal position `x,y,z` (repeat for several regions of interest).
-    #[arg(long = "goal", value_parser = parse_point, allow_hyphen_values = true, required = true)]
+    #[arg(long = "goal", value_parser = parse_point, allow_hyphen_values = true, required_unless_present = "problem", conflicts_with = "problem")]
     pub goals: Vec<Point3>,
     /// How close a vertex must come to a goal, metres.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, conflicts_with = "problem")]
     pub goal_tolerance: Real,
     /// The planner.
     #[arg(long, value_enum, default_value_t = PlannerChoice::Rrt)]
     pub planner: PlannerChoice,
     /// Robot radius (the capsule radius of every step), metres.
-    #[arg(long)]
-    pub radius: Real,
+    #[arg(long, required_unless_present = "problem", conflicts_with = "problem")]
+    pub radius: Option<Real>,
     /// Longest tree edge (RRT), metres.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, conflicts_with = "problem")]
     pub step: Real,
     /// Seed of the planner's random samples.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, conflicts_with = "problem")]
     pub seed: u64,
     /// Iteration budget.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(long, default_value_t = 10_000, conflicts_with = "problem")]
     pub iterations: u64,
     /// Keep growing after every goal is reached (the thesis's fixed-K runs) instead of stopping.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "problem")]
     pub explore: bool,
     /// Write the roadmap as OBJ polylines.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "problem")]
     pub roadmap_out: Option<PathBuf>,
     /// Write the path to the first goal as an OBJ polyline.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "problem")]
     pub path_out: Option<PathBuf>,
+    #[command(flatten)]
+    pub problem: crate::problem::ProblemArgs,
 }
 
 fn parse_point(text: &str) -> Result<Point3, String> {
@@ -81,32 +85,29 @@ fn parse_point(text: &str) -> Result<Point3, String> {
 
 /// Runs `patchnav plan`.
 pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
-    let map = crate::map::open_map(&args.map)?;
+    if args.problem.problem.is_some() {
+        return crate::problem::run(&args.problem, args.planner, progress);
+    }
+    // clap enforces these when there is no --problem.
+    let (Some(map_path), Some(start), Some(radius)) = (&args.map, args.start, args.radius) else {
+        bail!("give a MAP with --start, --goal and --radius, or --problem");
+    };
+    let map = crate::map::open_map(map_path)?;
     let bounds = crate::map::map_bounds(&map);
     if bounds.is_empty() {
-        bail!("{}: the map is empty, so it has no bounds to sample in", args.map.display());
+        bail!("{}: the map is empty, so it has no bounds to sample in", map_path.display());
     }
-    let space = PlanningSpace::new(bounds, args.radius, args.step)
+    let space = PlanningSpace::new(bounds, radius, args.step)
         .context("--radius and --step must be positive numbers of metres")?;
     let problem = Problem {
-        start: args.start,
+        start,
         goals: args
             .goals
             .iter()
             .map(|&center| Goal { center, tolerance: args.goal_tolerance })
             .collect(),
     };
-    let mut planner: Box<dyn Planner + '_> = match args.planner {
-        PlannerChoice::Rrt => Box::new(Rrt::new(&map, space, RrtConfig::lesum(None), args.seed)),
-        PlannerChoice::Prm => Box::new(Prm::new(&map, space, PrmConfig::thesis(), args.seed)),
-        PlannerChoice::RrtConnect => {
-            if problem.goals.len() != 1 {
-                bail!("rrt-connect plans to exactly one --goal");
-            }
-            Box::new(RrtConnect::new(&map, space, args.seed))
-        }
-        PlannerChoice::EvasionRrt => evasion_planner(&map, space, args.seed)?,
-    };
+    let mut planner = make_planner(args.planner, &map, space, args.seed, problem.goals.len())?;
     let spinner = progress.spinner("planning");
     let status = if args.explore {
         planner.solve(&problem, &mut MaxIterations(args.iterations))
@@ -170,9 +171,34 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
+/// The planner `choice` on `map`.
+pub(crate) fn make_planner(
+    choice: PlannerChoice,
+    map: &AnyMap,
+    space: PlanningSpace,
+    seed: u64,
+    num_goals: usize,
+) -> Result<Box<dyn Planner + '_>> {
+    Ok(match choice {
+        PlannerChoice::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
+        PlannerChoice::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
+        PlannerChoice::RrtConnect => {
+            if num_goals > 1 {
+                bail!("rrt-connect plans to exactly one --goal");
+            }
+            Box::new(RrtConnect::new(map, space, seed))
+        }
+        PlannerChoice::EvasionRrt => evasion_planner(map, space, seed)?,
+    })
+}
+
 /// The Evasion RRT on the concrete backend of `map` (it needs specific step hits, which a
 /// point-cloud map cannot give: thesis Table 5.2).
-fn evasion_planner(map: &AnyMap, space: PlanningSpace, seed: u64) -> Result<Box<dyn Planner + '_>> {
+pub(crate) fn evasion_planner(
+    map: &AnyMap,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + '_>> {
     let config = EvasionRrtConfig::for_space(&space);
     Ok(match map {
         AnyMap::Polygon(m) => Box::new(EvasionRrt::new(m, space, config, seed)),

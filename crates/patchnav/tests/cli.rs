@@ -471,3 +471,54 @@ fn plan_offers_rrt_connect_and_evasion_rrt_where_the_map_allows() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(info_field(&stdout(&o), "status"), "Exact", "{}", stdout(&o));
 }
+
+#[test]
+fn plan_runs_a_shared_format_problem_as_json_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    write_small_obj(dir.path());
+    let problem = dir.path().join("room.json");
+    std::fs::write(
+        &problem,
+        r#"{"name": "room", "mesh": "room.obj", "robot_radius": 0.2, "max_step": 0.5,
+            "bounds": {"min": [0, 0, 0], "max": [4, 3, 2]}, "start": [0.5, 2.5, 1],
+            "goals": [[3.5, 2.5, 1.5], [3.5, 0.5, 0.5]], "goal_tolerance": 0.3,
+            "iterations": 300, "seeds": [4, 5, 6], "unknown_key": "ignored"}"#,
+    )
+    .unwrap();
+    let rows = |mode: &str, backend: &str| -> Vec<serde_json::Value> {
+        let o = patchnav(&[
+            "plan",
+            "--problem",
+            problem.to_str().unwrap(),
+            "--backend",
+            backend,
+            "--mode",
+            mode,
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+    };
+    let roi = rows("roi", "bbox6d");
+    assert_eq!(roi.len(), 3, "one line per seed");
+    for r in &roi {
+        assert_eq!(r["kind"], "planning");
+        assert_eq!(r["problem"], "room");
+        assert_eq!(r["solved"], true, "{r}");
+        assert_eq!(r["goals"].as_array().unwrap().len(), 2);
+        assert!(r["path_length"].as_f64().unwrap() > 0.0);
+    }
+    let solve = rows("solve", "trimesh");
+    assert_eq!(solve.len(), 6, "one line per seed and goal");
+    assert_eq!(solve[1]["goal"], 1);
+    let explore = rows("explore", "pointcloud");
+    assert!(explore.iter().all(|r| r["iterations"] == 300 && r["solved"] == false));
+    // Same seeds, same results (up to the timing).
+    let again = rows("roi", "bbox6d");
+    for (a, b) in roi.iter().zip(&again) {
+        assert_eq!(a["vertices"], b["vertices"]);
+        assert_eq!(a["path_length"], b["path_length"]);
+    }
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, r#"{"mesh": "room.obj"}"#).unwrap();
+    assert_one_line_error(&patchnav(&["plan", "--problem", bad.to_str().unwrap()]), "missing");
+}

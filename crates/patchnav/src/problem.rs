@@ -1,0 +1,243 @@
+//! `patchnav plan --problem P.json --backend B --planner X --mode explore|solve|roi`: the runs
+//! of a planning problem in the shared exchange format (its `FORMAT.md`: problem JSON in, one
+//! JSON line per run out), so our runs and other tools' runs on the same problem compare
+//! directly.
+//!
+//! * `explore`: grow for exactly `iterations` iterations with no reachable goal;
+//! * `solve`: one query start → goal per goal (the line names the goal's index), stopping when
+//!   it is reached or after `iterations`;
+//! * `roi`: reach every goal from the start with one growing tree or roadmap (the thesis's
+//!   preliminary experiment, §5.5.3), stopping when all are reached or after `iterations`.
+
+use crate::plan::{PlannerChoice, make_planner};
+use crate::progress::Progress;
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use patch_core::{FromPatches, Point3, Real};
+use patch_map::{
+    AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
+    planar_patches_from_mesh, sample_patch_points,
+};
+use pointcloud::Aabb;
+use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, PlanningSpace, Problem};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The backends a problem's mesh can be loaded into.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ProblemBackend {
+    /// Native polygons, no broad phase.
+    Polygon,
+    /// 6D bounding-box k-d forest.
+    Bbox6d,
+    /// One parry triangle mesh.
+    Trimesh,
+    /// One rapier collider per patch.
+    Rapier,
+    /// The mesh's surfaces sampled into a point-cloud map.
+    Pointcloud,
+}
+
+/// What the runs of a problem do.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// Exactly `iterations` iterations, no goal.
+    Explore,
+    /// One query per goal.
+    Solve,
+    /// All goals with one tree or roadmap.
+    Roi,
+}
+
+/// The `--problem` options of `patchnav plan`.
+#[derive(Args, Debug)]
+pub struct ProblemArgs {
+    /// A planning problem JSON (mesh, robot_radius, max_step, bounds, start, goals,
+    /// goal_tolerance, iterations, seeds); prints one JSON line per run.
+    #[arg(long)]
+    pub problem: Option<PathBuf>,
+    /// The backend the problem's mesh is loaded into.
+    #[arg(long, value_enum, default_value_t = ProblemBackend::Bbox6d, requires = "problem")]
+    pub backend: ProblemBackend,
+    /// What each run does.
+    #[arg(long, value_enum, default_value_t = Mode::Roi, requires = "problem")]
+    pub mode: Mode,
+    /// Point spacing when the backend is `pointcloud`, metres (default: a quarter of the robot
+    /// radius, well inside the density the point-cloud map assumes).
+    #[arg(long = "sample-spacing", requires = "problem")]
+    pub sample_spacing: Option<Real>,
+}
+
+struct ProblemFile {
+    name: String,
+    mesh: PathBuf,
+    robot_radius: Real,
+    max_step: Real,
+    bounds: Aabb,
+    start: Point3,
+    goals: Vec<Point3>,
+    goal_tolerance: Real,
+    iterations: u64,
+    seeds: Vec<u64>,
+}
+
+fn point(v: &Value, what: &str) -> Result<Point3> {
+    let a: Vec<Real> = v
+        .as_array()
+        .with_context(|| format!("`{what}` is not an array"))?
+        .iter()
+        .map(|x| x.as_f64().with_context(|| format!("`{what}` holds a non-number")))
+        .collect::<Result<_>>()?;
+    match a[..] {
+        [x, y, z] if a.iter().all(|c| c.is_finite()) => Ok(Point3::new(x, y, z)),
+        _ => bail!("`{what}` is not three finite numbers"),
+    }
+}
+
+fn number(v: &Value, key: &str) -> Result<Real> {
+    v.get(key)
+        .and_then(Value::as_f64)
+        .with_context(|| format!("`{key}` is missing or not a number"))
+}
+
+fn read_problem(path: &Path) -> Result<ProblemFile> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let v: Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let mesh = v.get("mesh").and_then(Value::as_str).context("`mesh` is missing")?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let bounds = v.get("bounds").context("`bounds` is missing")?;
+    let goals = v
+        .get("goals")
+        .and_then(Value::as_array)
+        .context("`goals` is missing")?
+        .iter()
+        .enumerate()
+        .map(|(i, g)| point(g, &format!("goals[{i}]")))
+        .collect::<Result<_>>()?;
+    let seeds = match v.get("seeds") {
+        None => vec![0],
+        Some(s) => s
+            .as_array()
+            .context("`seeds` is not an array")?
+            .iter()
+            .map(|x| x.as_u64().context("`seeds` holds a value that is not a non-negative integer"))
+            .collect::<Result<_>>()?,
+    };
+    let iterations = number(&v, "iterations")?;
+    if !(iterations >= 0.0 && iterations.fract() == 0.0 && iterations <= 1e9) {
+        bail!("`iterations` must be a whole number up to 10⁹, got {iterations}");
+    }
+    Ok(ProblemFile {
+        name: v.get("name").and_then(Value::as_str).unwrap_or("problem").to_owned(),
+        mesh: dir.join(mesh),
+        robot_radius: number(&v, "robot_radius")?,
+        max_step: number(&v, "max_step")?,
+        bounds: Aabb::new(
+            point(bounds.get("min").context("`bounds.min` is missing")?, "bounds.min")?,
+            point(bounds.get("max").context("`bounds.max` is missing")?, "bounds.max")?,
+        ),
+        start: point(v.get("start").context("`start` is missing")?, "start")?,
+        goals,
+        goal_tolerance: number(&v, "goal_tolerance")?,
+        iterations: iterations as u64,
+        seeds,
+    })
+}
+
+fn load_map(p: &ProblemFile, args: &ProblemArgs) -> Result<AnyMap> {
+    let mesh = pointcloud::io::read_mesh(&p.mesh)?;
+    let (patches, _) = planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
+    Ok(match args.backend {
+        ProblemBackend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
+        ProblemBackend::Bbox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
+        ProblemBackend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
+        ProblemBackend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
+        ProblemBackend::Pointcloud => {
+            let spacing = args.sample_spacing.unwrap_or(p.robot_radius / 4.0);
+            AnyMap::PointCloud(PointCloudMap::from_points(&sample_patch_points(
+                &patches, spacing,
+            )?)?)
+        }
+    })
+}
+
+/// Runs every seed (and in `solve` mode every goal) of the problem; prints one JSON line each.
+pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Result<()> {
+    let path = args.problem.as_ref().context("--problem is missing")?;
+    let p = read_problem(path)?;
+    let map = load_map(&p, args)?;
+    let space = PlanningSpace::new(p.bounds, p.robot_radius, p.max_step)
+        .with_context(|| format!("{}: bounds, robot_radius, max_step", path.display()))?;
+    let queries: Vec<(Option<usize>, Vec<Point3>)> = match args.mode {
+        Mode::Explore => vec![(None, Vec::new())],
+        Mode::Roi => vec![(None, p.goals.clone())],
+        Mode::Solve => p.goals.iter().enumerate().map(|(i, g)| (Some(i), vec![*g])).collect(),
+    };
+    let mode = format!("{:?}", args.mode).to_lowercase();
+    let bar = progress.bar((p.seeds.len() * queries.len()) as u64, "runs");
+    for &seed in &p.seeds {
+        for (goal_index, goals) in &queries {
+            let problem = Problem {
+                start: p.start,
+                goals: goals
+                    .iter()
+                    .map(|&center| Goal { center, tolerance: p.goal_tolerance })
+                    .collect(),
+            };
+            let mut planner = make_planner(choice, &map, space, seed, goals.len())?;
+            let t = Instant::now();
+            let status = if args.mode == Mode::Explore {
+                planner.solve(&problem, &mut MaxIterations(p.iterations))
+            } else {
+                planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(p.iterations)))
+            };
+            let time_s = t.elapsed().as_secs_f64();
+            let paths: Vec<Option<Vec<Point3>>> =
+                (0..goals.len()).map(|i| planner.path_to(i)).collect();
+            let solved = args.mode != Mode::Explore && paths.iter().all(Option::is_some);
+            let path_length = solved.then(|| {
+                paths.iter().flatten().map(|path| PathMetrics::of(path).length).sum::<Real>()
+            });
+            let c = planner.counters();
+            let mut row = json!({
+                "kind": "planning",
+                "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
+                "planner": planner.name(),
+                "backend": map.backend(),
+                "map": p.mesh.file_name().map(|f| f.to_string_lossy().into_owned()),
+                "problem": p.name,
+                "mode": mode,
+                "seed": seed,
+                "iterations": c.samples,
+                "vertices": planner.roadmap().node_count(),
+                "time_s": time_s,
+                "collision_checks": c.collision_checks,
+                "solved": solved,
+                "path_length": path_length,
+                "status": format!("{status:?}"),
+                "motion": "capsule",
+            });
+            if let Some(i) = goal_index {
+                row["goal"] = json!(i);
+            }
+            if args.mode == Mode::Roi {
+                row["goals"] = paths
+                    .iter()
+                    .map(|path| match path {
+                        Some(path) => {
+                            json!({"solved": true, "path_length": PathMetrics::of(path).length})
+                        }
+                        None => json!({"solved": false, "path_length": null}),
+                    })
+                    .collect();
+            }
+            bar.suspend(|| println!("{row}"));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(())
+}
