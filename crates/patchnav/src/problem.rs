@@ -187,7 +187,25 @@ pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Re
                     .map(|&center| Goal { center, tolerance: p.goal_tolerance })
                     .collect(),
             };
-            let mut planner = make_planner(choice, &map, space, seed, goals.len())?;
+            let mut planner = match make_planner(choice, &map, space, seed, goals.len()) {
+                Ok(planner) => planner,
+                Err(reason) => {
+                    // A run that cannot be made is recorded, as the results format asks.
+                    let row = json!({
+                        "kind": "planning",
+                        "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
+                        "planner": format!("{choice:?}"),
+                        "backend": map.backend(),
+                        "problem": p.name,
+                        "mode": mode,
+                        "seed": seed,
+                        "skipped": format!("{reason:#}"),
+                    });
+                    bar.suspend(|| println!("{row}"));
+                    bar.inc(1);
+                    continue;
+                }
+            };
             let t = Instant::now();
             let status = if args.mode == Mode::Explore {
                 planner.solve(&problem, &mut MaxIterations(p.iterations))

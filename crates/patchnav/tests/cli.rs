@@ -518,6 +518,21 @@ fn plan_runs_a_shared_format_problem_as_json_lines() {
         assert_eq!(a["vertices"], b["vertices"]);
         assert_eq!(a["path_length"], b["path_length"]);
     }
+    // RRT-Connect plans to one goal: its roi runs are recorded as skipped, not failed.
+    let o = patchnav(&[
+        "plan",
+        "--problem",
+        problem.to_str().unwrap(),
+        "--planner",
+        "rrt-connect",
+        "--mode",
+        "roi",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let skipped: Vec<serde_json::Value> =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(skipped.len(), 3);
+    assert!(skipped.iter().all(|r| r["skipped"].as_str().unwrap().contains("one --goal")));
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, r#"{"mesh": "room.obj"}"#).unwrap();
     assert_one_line_error(&patchnav(&["plan", "--problem", bad.to_str().unwrap()]), "missing");
