@@ -167,7 +167,8 @@ impl<M: SpecificStepIntersector<CapsuleStep> + ?Sized> Planner for EvasionRrt<'_
             }
         };
         let solution = &mut self.solution;
-        solve_rrt(self.map, &self.space, &config.rrt, self.seed, problem, stop, solution, extend)
+        let (map, space, rrt) = (self.map, &self.space, &config.rrt);
+        solve_rrt(map, space, rrt, self.seed, problem, stop, solution, Some, extend)
     }
 
     fn roadmap(&self) -> &Roadmap {

@@ -1,6 +1,7 @@
-//! Roadmap planners on patch maps: the RRT, the PRM and the Evasion RRT of the thesis
-//! (Poppinga 2010, "Towards Autonomous Navigation for Robots with 3D Sensors", §5.5 and §6.1,
-//! Algorithms 13, 14 and 11), RRT-Connect as a baseline from the literature, and the path
+//! Roadmap planners on patch maps: the RRT, the PRM, the Evasion RRT and the medial-axis
+//! planners of the thesis (Poppinga 2010, "Towards Autonomous Navigation for Robots with 3D
+//! Sensors", §5.5 and §6.1, Algorithms 13, 14, 11 and 12), RRT-Connect as a baseline from the
+//! literature, and the path
 //! metrics of the thesis's benchmark ([`metrics`]); generic over the collision capabilities
 //! of `patch-core` and never over a backend.
 //!
@@ -11,11 +12,14 @@
 //! | RRT (Alg. 13) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Rrt`] |
 //! | PRM (Alg. 14) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] |
 //! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector<CapsuleStep>`] | [`EvasionRrt`] |
-//! | MA RRT, MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | not yet |
+//! | MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaPrm`] |
+//! | MA RRT (§5.5.2, no pseudo-code) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaRrt`] |
 //! | RRT-Connect (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtConnect`] |
 //!
 //! A planner states its capability as a trait bound, so a map without it is rejected at
-//! compile time.
+//! compile time: the point-cloud map (`PointCloudMap` of `patch-map`), which answers no
+//! closest-patch queries, runs the RRT, PRM and RRT-Connect but not the medial-axis planners
+//! (thesis Table 5.2).
 //!
 //! [`UnspecificStepIntersector<CapsuleStep>`]: patch_core::UnspecificStepIntersector
 //! [`SpecificStepIntersector<CapsuleStep>`]: patch_core::SpecificStepIntersector
@@ -30,9 +34,10 @@
 //! * [`Planner`]: the object-safe face, `solve` → [`PlannerStatus`] (an outcome, not an
 //!   error), the [`Roadmap`] (a petgraph graph, edge weight = length), paths and
 //!   [`PlannerCounters`] (samples, vertices, edges, collision checks and their time).
-//! * Each planner is generic over the one capability it needs (table above); configs
-//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`]) have no `Default` but named
-//!   constructors with the thesis's choices, or documented ones where the thesis gives none.
+//! * Each planner is generic over the capabilities it needs (table above); configs
+//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`], [`MaPrmConfig`], [`MaRrtConfig`])
+//!   have no `Default` but named constructors with the thesis's choices, or documented ones
+//!   where the thesis gives none.
 //!
 //! Runs are deterministic: a planner takes a seed (ChaCha8), every `solve` starts from it,
 //! and nearest-neighbour queries ([`KdNeighbors`], checked against the linear scan
@@ -54,11 +59,20 @@
 //!   spec's repair (shift `x_new` by `l_ev · unit(u × n_p)` while the hit patch stays the same
 //!   planar patch, at most `E` times, add only if free). The thesis gives neither `l_ev` nor
 //!   `E`; [`EvasionRrtConfig::for_space`] documents this crate's values.
+//! * Medial axis (§5.5.2): [`retract_to_medial_axis`] moves a sample away from its closest
+//!   patch along the ray from the closest point through the sample, brackets (doubling, inside
+//!   the box) and bisects the change of the closest patch, and drops the sample if there is
+//!   none inside the box or the sample lies on a patch (the spec's recommendation, §4). The
+//!   thesis gives neither the solver, its tolerance nor `N`; [`MaPrmConfig::for_space`] and
+//!   [`MaRrtConfig::for_space`] document this crate's values. The MA RRT has no pseudo-code
+//!   in the thesis; [`MaRrt`] retracts each sample, then takes one RRT step toward it (the
+//!   spec's recommendation, §4). Closest-patch queries are not counted in
+//!   [`PlannerCounters`].
 //! * Path metrics (§5.5.4, Tables 5.5–5.11): the thesis does not define its quartile; see
 //!   [`metrics`] for the method used and the treatment of straight and repeated vertices.
 //!
 //! # Not yet here
-//! The medial-axis planners (MA RRT, MA PRM, Algorithm 12), RRT*, PRM*, lazy PRM, path
+//! RRT*, PRM*, lazy PRM, path
 //! smoothing, roadmap metrics (only path metrics exist), the explored volume, the thesis's
 //! experiments, benchmarks, and a choice of nearest-neighbour structure per planner (all use
 //! [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL k-d tree for PRM, §6.1).
@@ -90,6 +104,7 @@
 
 mod connect;
 mod evasion;
+mod medial;
 pub mod metrics;
 mod nn;
 mod planner;
@@ -100,6 +115,7 @@ mod termination;
 
 pub use connect::RrtConnect;
 pub use evasion::{EvasionRrt, EvasionRrtConfig};
+pub use medial::{MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, retract_to_medial_axis};
 pub use metrics::PathMetrics;
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};

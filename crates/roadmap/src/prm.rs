@@ -85,7 +85,10 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
-        solve_prm(self.map, &self.space, &self.config, self.seed, problem, stop, &mut self.solution)
+        let space = &self.space;
+        let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
+        let solution = &mut self.solution;
+        solve_prm(self.map, space, &self.config, self.seed, problem, stop, solution, sample)
     }
 
     fn roadmap(&self) -> &Roadmap {
@@ -135,7 +138,10 @@ impl Forest {
     }
 }
 
-fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+/// The PRM loop shared by [`Prm`] and the MA PRM: `sample(rng)` gives the next vertex, or
+/// `None` to drop the iteration's sample (it still counts as an iteration).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     config: &PrmConfig,
@@ -143,6 +149,7 @@ fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     problem: &Problem,
     stop: &mut dyn Termination,
     solution: &mut Solution,
+    mut sample: impl FnMut(&mut ChaCha8Rng) -> Option<Point3>,
 ) -> PlannerStatus {
     let started = Instant::now();
     solution.reset(&problem.goals);
@@ -170,7 +177,9 @@ fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     let mut iterations = 0u64;
     while !stop.should_stop(&solution.progress(iterations, started)) {
         iterations += 1;
-        let x = planner::uniform(&mut rng, space);
+        let Some(x) = sample(&mut rng) else {
+            continue;
+        };
         let near = forest.nn.k_nearest(&x, config.neighbours, max_dist);
         let v = forest.add(solution, x);
         for n in near {

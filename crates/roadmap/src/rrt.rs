@@ -117,7 +117,8 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
             (bounds.contains(x_new) && checker.free(x_near, x_new)).then_some(*x_new)
         };
         let solution = &mut self.solution;
-        solve_rrt(self.map, &self.space, &self.config, self.seed, problem, stop, solution, extend)
+        let (map, space, config) = (self.map, &self.space, &self.config);
+        solve_rrt(map, space, config, self.seed, problem, stop, solution, Some, extend)
     }
 
     fn roadmap(&self) -> &Roadmap {
@@ -137,9 +138,12 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
     }
 }
 
-/// The RRT loop shared by [`Rrt`] and the Evasion RRT: `extend(checker, x_near, x_new)`
-/// returns the vertex to add with an edge to `x_near` (`x_new` itself for the plain RRT, a
-/// shifted point for the Evasion RRT), or `None` if the extension is Trapped.
+/// The RRT loop shared by [`Rrt`], the Evasion RRT and the MA RRT: `retract(x)` maps each
+/// sample that is not a goal centre chosen by the goal bias to the point to extend toward
+/// (`Some(x)` for the plain RRT, the retraction onto the medial axis for the MA RRT), `None`
+/// dropping the iteration's sample; `extend(checker, x_near, x_new)` returns the vertex to add
+/// with an edge to `x_near` (`x_new` itself for the plain RRT, a shifted point for the Evasion
+/// RRT), or `None` if the extension is Trapped.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     map: &'m M,
@@ -149,6 +153,7 @@ pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     problem: &Problem,
     stop: &mut dyn Termination,
     solution: &mut Solution,
+    mut retract: impl FnMut(Point3) -> Option<Point3>,
     mut extend: impl FnMut(&mut Checker<'m, M>, &Point3, &Point3) -> Option<Point3>,
 ) -> PlannerStatus {
     let started = Instant::now();
@@ -166,7 +171,11 @@ pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     let mut iterations = 0u64;
     while !stop.should_stop(&solution.progress(iterations, started)) {
         iterations += 1;
-        let x = sample(&mut rng, space, config, solution);
+        let (x, goal_centre) = sample(&mut rng, space, config, solution);
+        let x = if goal_centre { Some(x) } else { retract(x) };
+        let Some(x) = x else {
+            continue;
+        };
         let Some(near) = nn.nearest(&x) else { break };
         if near.distance <= 0.0 {
             continue;
@@ -220,28 +229,30 @@ fn test_goals<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     }
 }
 
+/// The next sample, and whether it is a goal centre chosen by the goal bias.
 fn sample(
     rng: &mut ChaCha8Rng,
     space: &PlanningSpace,
     config: &RrtConfig,
     solution: &Solution,
-) -> Point3 {
+) -> (Point3, bool) {
     let unreached: Vec<usize> =
         (0..solution.goals.len()).filter(|&g| solution.reached[g].is_none()).collect();
     if unreached.is_empty() {
-        return planner::uniform(rng, space);
+        return (planner::uniform(rng, space), false);
     }
     let bias = if config.goal_bias.is_nan() { 0.0 } else { config.goal_bias.clamp(0.0, 1.0) };
     if bias > 0.0 && rng.random::<Real>() < bias {
-        return solution.goals[unreached[rng.random_range(0..unreached.len())]].center;
+        return (solution.goals[unreached[rng.random_range(0..unreached.len())]].center, true);
     }
-    match config.sampler {
+    let x = match config.sampler {
         Sampler::Uniform => planner::uniform(rng, space),
         Sampler::GoalGaussian { factor } => {
             let center = solution.goals[unreached[rng.random_range(0..unreached.len())]].center;
             gaussian_in_box(rng, space, &center, factor)
         }
-    }
+    };
+    (x, false)
 }
 
 /// Per axis: `N(center, σ²)` with `σ = sqrt(d_far[mm] · factor)` mm, redrawn until inside the
