@@ -1,4 +1,4 @@
-//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|rrt-connect|evasion-rrt ...`: one planning run on a
+//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
 //! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
 
@@ -8,8 +8,9 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaxIterations, PathMetrics, Planner,
-    PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig, RrtConnect,
+    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
+    MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
+    RrtConnect,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -25,6 +26,10 @@ pub enum PlannerChoice {
     RrtConnect,
     /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
     EvasionRrt,
+    /// Medial-axis PRM (thesis Algorithm 12): needs a patch map (proximity queries).
+    MaPrm,
+    /// Medial-axis RRT (thesis §5.5.2): needs a patch map (proximity queries).
+    MaRrt,
 }
 
 /// Arguments of `patchnav plan`: either one run on a map file (`MAP --start --goal --radius`),
@@ -189,6 +194,43 @@ pub(crate) fn make_planner(
             Box::new(RrtConnect::new(map, space, seed))
         }
         PlannerChoice::EvasionRrt => evasion_planner(map, space, seed)?,
+        PlannerChoice::MaPrm | PlannerChoice::MaRrt => medial_planner(choice, map, space, seed)?,
+    })
+}
+
+/// A medial-axis planner on the concrete backend of `map` (it needs proximity queries, which a
+/// point-cloud map cannot answer: thesis Table 5.2).
+fn medial_planner(
+    choice: PlannerChoice,
+    map: &AnyMap,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + '_>> {
+    fn make<'m, M>(
+        choice: PlannerChoice,
+        m: &'m M,
+        space: PlanningSpace,
+        seed: u64,
+    ) -> Box<dyn Planner + 'm>
+    where
+        M: patch_core::ProximityQuery
+            + patch_core::UnspecificStepIntersector<patch_core::CapsuleStep>,
+    {
+        if choice == PlannerChoice::MaPrm {
+            Box::new(MaPrm::new(m, space, MaPrmConfig::for_space(&space), seed))
+        } else {
+            Box::new(MaRrt::new(m, space, MaRrtConfig::for_space(&space), seed))
+        }
+    }
+    Ok(match map {
+        AnyMap::Polygon(m) => make(choice, m, space, seed),
+        AnyMap::BBox6d(m) => make(choice, m, space, seed),
+        AnyMap::Trimesh(m) => make(choice, m, space, seed),
+        AnyMap::Rapier(m) => make(choice, m, space, seed),
+        other => bail!(
+            "{choice:?} needs a map that answers proximity queries; a `{}` map cannot",
+            other.backend()
+        ),
     })
 }
 

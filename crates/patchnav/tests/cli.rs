@@ -467,6 +467,12 @@ fn plan_offers_rrt_connect_and_evasion_rrt_where_the_map_allows() {
         "exactly one --goal",
     );
     assert_one_line_error(&plan(&cloud, "evasion-rrt", &["3.5,2.5,1.5"]), "`pointcloud` map");
+    for planner in ["ma-prm", "ma-rrt"] {
+        assert_one_line_error(&plan(&cloud, planner, &["3.5,2.5,1.5"]), "proximity");
+        let o = plan(&map, planner, &["3.5,2.5,1.5"]);
+        assert!(o.status.success(), "{planner}: {}", stderr(&o));
+        assert!(stdout(&o).contains("status:"), "{}", stdout(&o));
+    }
     let o = plan(&cloud, "rrt", &["3.5,2.5,1.5"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(info_field(&stdout(&o), "status"), "Exact", "{}", stdout(&o));
