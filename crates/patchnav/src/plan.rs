@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 /// The planners `plan` offers.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PlannerChoice {
-    /// Rapidly-exploring random tree (thesis Algorithm 13), with the direct goal step.
+    /// Rapidly-exploring random tree (thesis Algorithm 13).
     Rrt,
     /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
     Prm,
@@ -176,7 +176,15 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// The planner `choice` on `map`.
+/// PRM as the thesis configures it (six neighbours), with the direct goal step that every
+/// planner of this command uses.
+fn prm_config() -> PrmConfig {
+    PrmConfig { direct_goal_step: true, ..PrmConfig::thesis() }
+}
+
+/// The planner `choice` on `map`. Every planner tests, after each added vertex, whether the
+/// goal is directly reachable by one free capsule step (the thesis's §6.2.3 variant), so their
+/// results compare.
 pub(crate) fn make_planner(
     choice: PlannerChoice,
     map: &AnyMap,
@@ -186,7 +194,7 @@ pub(crate) fn make_planner(
 ) -> Result<Box<dyn Planner + '_>> {
     Ok(match choice {
         PlannerChoice::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
-        PlannerChoice::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
+        PlannerChoice::Prm => Box::new(Prm::new(map, space, prm_config(), seed)),
         PlannerChoice::RrtConnect => {
             if num_goals > 1 {
                 bail!("rrt-connect plans to exactly one --goal");
@@ -217,9 +225,12 @@ fn medial_planner(
             + patch_core::UnspecificStepIntersector<patch_core::CapsuleStep>,
     {
         if choice == PlannerChoice::MaPrm {
-            Box::new(MaPrm::new(m, space, MaPrmConfig::for_space(&space), seed))
+            let config = MaPrmConfig { prm: prm_config(), ..MaPrmConfig::for_space(&space) };
+            Box::new(MaPrm::new(m, space, config, seed))
         } else {
-            Box::new(MaRrt::new(m, space, MaRrtConfig::for_space(&space), seed))
+            let config =
+                MaRrtConfig { rrt: RrtConfig::lesum(None), ..MaRrtConfig::for_space(&space) };
+            Box::new(MaRrt::new(m, space, config, seed))
         }
     }
     Ok(match map {
@@ -241,7 +252,8 @@ pub(crate) fn evasion_planner(
     space: PlanningSpace,
     seed: u64,
 ) -> Result<Box<dyn Planner + '_>> {
-    let config = EvasionRrtConfig::for_space(&space);
+    let config =
+        EvasionRrtConfig { rrt: RrtConfig::lesum(None), ..EvasionRrtConfig::for_space(&space) };
     Ok(match map {
         AnyMap::Polygon(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
         AnyMap::BBox6d(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
