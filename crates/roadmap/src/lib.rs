@@ -1,9 +1,9 @@
 //! Roadmap planners on patch maps: the RRT, the PRM, the Evasion RRT and the medial-axis
 //! planners of the thesis (Poppinga 2010, "Towards Autonomous Navigation for Robots with 3D
 //! Sensors", §5.5 and §6.1, Algorithms 13, 14, 11 and 12), RRT-Connect as a baseline from the
-//! literature, and the path
-//! metrics of the thesis's benchmark ([`metrics`]); generic over the collision capabilities
-//! of `patch-core` and never over a backend.
+//! literature, PRM* (Karaman & Frazzoli 2011) as an option of the PRM, the path metrics of the
+//! thesis's benchmark ([`metrics`]) and path shortcutting as a post-process ([`smoothing`]);
+//! generic over the collision capabilities of `patch-core` and never over a backend.
 //!
 //! # Planners and the capabilities they need (thesis Table 5.2)
 //!
@@ -11,15 +11,17 @@
 //! |---|---|---|
 //! | RRT (Alg. 13) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Rrt`] |
 //! | PRM (Alg. 14) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] |
+//! | PRM* (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] with [`PrmConfig::star()`] |
 //! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector<CapsuleStep>`] | [`EvasionRrt`] |
 //! | MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaPrm`] |
 //! | MA RRT (§5.5.2, no pseudo-code) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaRrt`] |
 //! | RRT-Connect (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtConnect`] |
+//! | path shortcutting (post-process, not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`shortcut_path`] |
 //!
 //! A planner states its capability as a trait bound, so a map without it is rejected at
 //! compile time: the point-cloud map (`PointCloudMap` of `patch-map`), which answers no
-//! closest-patch queries, runs the RRT, PRM and RRT-Connect but not the medial-axis planners
-//! (thesis Table 5.2).
+//! closest-patch queries, runs the RRT, PRM and RRT-Connect (and path shortcutting) but not
+//! the medial-axis planners (thesis Table 5.2).
 //!
 //! [`UnspecificStepIntersector<CapsuleStep>`]: patch_core::UnspecificStepIntersector
 //! [`SpecificStepIntersector<CapsuleStep>`]: patch_core::SpecificStepIntersector
@@ -35,9 +37,9 @@
 //!   error), the [`Roadmap`] (a petgraph graph, edge weight = length), paths and
 //!   [`PlannerCounters`] (samples, vertices, edges, collision checks and their time).
 //! * Each planner is generic over the capabilities it needs (table above); configs
-//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`], [`MaPrmConfig`], [`MaRrtConfig`])
-//!   have no `Default` but named constructors with the thesis's choices, or documented ones
-//!   where the thesis gives none.
+//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`], [`MaPrmConfig`], [`MaRrtConfig`],
+//!   and [`ShortcutConfig`] for the post-process) have no `Default` but named constructors
+//!   with the thesis's choices, or documented ones where the thesis gives none.
 //!
 //! Runs are deterministic: a planner takes a seed (ChaCha8), every `solve` starts from it,
 //! and nearest-neighbour queries ([`KdNeighbors`], checked against the linear scan
@@ -70,10 +72,18 @@
 //!   [`PlannerCounters`].
 //! * Path metrics (§5.5.4, Tables 5.5–5.11): the thesis does not define its quartile; see
 //!   [`metrics`] for the method used and the treatment of straight and repeated vertices.
+//! * PRM* (Karaman & Frazzoli 2011, k-nearest variant; [`PrmConfig::star`]): the PRM loop
+//!   with `k(n) = ⌈e·(1 + 1/3)·ln n⌉` neighbours for the `n`-th vertex
+//!   ([`PrmConfig::neighbours_for`]) and without the component test, so its roadmap has
+//!   cycles; paths of every planner are shortest by length in the roadmap (Dijkstra), which
+//!   in the forests of the other planners is the unique path.
+//! * Path shortcutting ([`smoothing`]): the thesis reports unsmoothed paths; [`shortcut_path`]
+//!   is a greedy pass plus random shortcuts ([`ShortcutConfig::standard`] documents this
+//!   crate's values). It never lengthens a path and adds only segments the map reported free.
 //!
 //! # Not yet here
-//! RRT*, PRM*, lazy PRM, path
-//! smoothing, roadmap metrics (only path metrics exist), the explored volume, the thesis's
+//! RRT*, lazy PRM, path smoothing other than shortcutting (e.g. splines), roadmap
+//! metrics (only path metrics exist), the explored volume, the thesis's
 //! experiments, benchmarks, and a choice of nearest-neighbour structure per planner (all use
 //! [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL k-d tree for PRM, §6.1).
 //! [`RrtConnect`] handles at most one goal.
@@ -110,6 +120,7 @@ mod nn;
 mod planner;
 mod prm;
 mod rrt;
+pub mod smoothing;
 mod space;
 mod termination;
 
@@ -121,5 +132,6 @@ pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
 pub use prm::{Prm, PrmConfig};
 pub use rrt::{Rrt, RrtConfig, Sampler};
+pub use smoothing::{ShortcutConfig, shortcut_path};
 pub use space::{Goal, PlanningSpace, Problem, SpaceError};
 pub use termination::{AnyOf, Deadline, GoalReached, MaxIterations, Progress, Termination};

@@ -124,8 +124,9 @@ fn default_tolerance(space: &PlanningSpace) -> Real {
 /// fields.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct MaPrmConfig {
-    /// The PRM's choices (neighbours `N`, connection radius, direct goal step); the thesis
-    /// gives no `N` for the MA PRM either (spec §7.4).
+    /// The PRM's choices (neighbours `N`, connection radius, direct goal step, and
+    /// [`PrmConfig::star`], which gives an MA PRM with PRM*'s neighbour count and cycles); the
+    /// thesis gives no `N` for the MA PRM either (spec §7.4).
     pub prm: PrmConfig,
     /// The solver tolerance of [`retract_to_medial_axis`] (metres; the length of the final
     /// bisection bracket). Must be finite and positive, otherwise every sample is dropped.

@@ -1,7 +1,6 @@
 //! The object-safe planner face, its outcome and counters, and the machinery the planners
 //! share (collision-check counting, start/goal validation, goal bookkeeping, paths).
 
-use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use patch_core::{
@@ -73,7 +72,8 @@ pub trait Planner {
 
     /// The path from the start to goal number `goal` of the last problem, or `None` if it is
     /// unreached or out of range. It ends at the vertex that reached the goal (within the
-    /// goal's tolerance, or the goal centre itself after a direct goal step).
+    /// goal's tolerance, or the goal centre itself after a direct goal step), and is the
+    /// shortest such path by length in the roadmap (the only one in a forest).
     fn path_to(&self, goal: usize) -> Option<Vec<Point3>>;
 
     /// The counters of the last `solve`.
@@ -226,34 +226,17 @@ impl Solution {
         PlannerStatus::Approximate { gap }
     }
 
-    /// The path from node 0 to the vertex that reached `goal` (breadth-first: the roadmaps
-    /// are forests, so the path is unique).
+    /// The path from node 0 to the vertex that reached `goal`: the shortest by edge length
+    /// (Dijkstra; in the forests of most planners it is the unique path).
     pub(crate) fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
         let target = (*self.reached.get(goal)?)?;
         let start = NodeIndex::new(0);
-        let mut parent: Vec<Option<NodeIndex>> = vec![None; self.graph.node_count()];
-        let mut queue = VecDeque::from([start]);
-        parent[start.index()] = Some(start);
-        while let Some(v) = queue.pop_front() {
-            if v == target {
-                break;
-            }
-            for w in self.graph.neighbors(v) {
-                if parent[w.index()].is_none() {
-                    parent[w.index()] = Some(v);
-                    queue.push_back(w);
-                }
-            }
+        if start.index() >= self.graph.node_count() {
+            return None;
         }
-        parent[target.index()]?;
-        let mut path = vec![self.graph[target]];
-        let mut v = target;
-        while v != start {
-            v = parent[v.index()]?;
-            path.push(self.graph[v]);
-        }
-        path.reverse();
-        Some(path)
+        let (_, nodes) =
+            petgraph::algo::astar(&self.graph, start, |v| v == target, |e| *e.weight(), |_| 0.0)?;
+        Some(nodes.into_iter().map(|v| self.graph[v]).collect())
     }
 }
 

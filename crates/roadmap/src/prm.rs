@@ -17,7 +17,8 @@ use crate::termination::Termination;
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct PrmConfig {
     /// How many nearest existing vertices a new sample tries to connect to (the thesis's `N`,
-    /// not given there; spec §7.4 recommends at least 6, Fig. 6.9).
+    /// not given there; spec §7.4 recommends at least 6, Fig. 6.9). Ignored with
+    /// [`star`](Self::star).
     pub neighbours: usize,
     /// Only vertices within this distance are tried; `None`: no edge-length limit, as in the
     /// thesis (§5.5, §6.1). A non-finite or negative radius connects nothing.
@@ -26,13 +27,40 @@ pub struct PrmConfig {
     /// capsule step from the vertex to the goal centre and on success add the centre as a
     /// vertex (the direct goal test of the thesis's Lesum variants, §6.2.3, carried over).
     pub direct_goal_step: bool,
+    /// PRM* (Karaman & Frazzoli 2011, the k-nearest variant; not in the thesis): a sample
+    /// added as the `n`-th vertex tries its `k(n) = ⌈e·(1 + 1/3)·ln n⌉` nearest existing
+    /// vertices (3D; [`PrmConfig::neighbours_for`]) instead of [`neighbours`](Self::neighbours),
+    /// and also connects to neighbours already in its component, so the roadmap has cycles and
+    /// paths are shortest by length in it. `false`: Algorithm 14's forest.
+    pub star: bool,
 }
 
 impl PrmConfig {
     /// Algorithm 14 as in the thesis: `N = 6` neighbours, no edge-length limit, no direct
     /// goal test.
     pub fn thesis() -> PrmConfig {
-        PrmConfig { neighbours: 6, connection_radius: None, direct_goal_step: false }
+        PrmConfig { neighbours: 6, connection_radius: None, direct_goal_step: false, star: false }
+    }
+
+    /// PRM* (Karaman & Frazzoli 2011, k-nearest variant): [`star`](Self::star) set, no
+    /// edge-length limit, no direct goal test.
+    pub fn star() -> PrmConfig {
+        PrmConfig { star: true, ..PrmConfig::thesis() }
+    }
+
+    /// How many nearest existing vertices a sample tries when it becomes the `vertices`-th
+    /// vertex (counting itself and the start): [`neighbours`](Self::neighbours), or with
+    /// [`star`](Self::star) `k(n) = ⌈e·(1 + 1/3)·ln n⌉` (0 for `n ≤ 1`).
+    pub fn neighbours_for(&self, vertices: usize) -> usize {
+        if !self.star {
+            return self.neighbours;
+        }
+        if vertices <= 1 {
+            return 0;
+        }
+        const DIMENSION: Real = 3.0;
+        let k = std::f64::consts::E * (1.0 + 1.0 / DIMENSION) * (vertices as Real).ln();
+        k.ceil() as usize
     }
 }
 
@@ -47,13 +75,18 @@ impl PrmConfig {
 /// sample stays isolated, because every capsule from it includes its sphere. The roadmap is a
 /// forest by construction. [`PlanningSpace::max_step`] is not used.
 ///
+/// With [`PrmConfig::star`] (PRM*, [`PrmConfig::star()`]) `N` grows with the vertex count
+/// ([`PrmConfig::neighbours_for`]) and the component test is dropped, so every free edge to
+/// the `k(n)` nearest vertices is added and the roadmap has cycles; [`Planner::path_to`]
+/// returns the shortest path by length in the roadmap.
+///
 /// A goal is reached once some vertex within its tolerance is in the start's component.
 ///
 /// Needs only [`UnspecificStepIntersector<CapsuleStep>`] (thesis Table 5.2).
 ///
 /// # Complexity
-/// Per iteration a [`KdNeighbors`] query for the neighbours plus at most `N` capsule checks
-/// (plus one per goal without a vertex, with the direct goal step).
+/// Per iteration a [`KdNeighbors`] query for the neighbours plus at most `N` (PRM*: `k(n)`,
+/// `O(log n)`) capsule checks (plus one per goal without a vertex, with the direct goal step).
 pub struct Prm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
@@ -180,11 +213,12 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
         let Some(x) = sample(&mut rng) else {
             continue;
         };
-        let near = forest.nn.k_nearest(&x, config.neighbours, max_dist);
+        let k = config.neighbours_for(solution.graph.node_count() + 1);
+        let near = forest.nn.k_nearest(&x, k, max_dist);
         let v = forest.add(solution, x);
         for n in near {
             let w = NodeIndex::new(n.index);
-            if !forest.components.equiv(v.index(), w.index())
+            if (config.star || !forest.components.equiv(v.index(), w.index()))
                 && checker.free(&solution.graph[w], &x)
             {
                 forest.connect(solution, w, v);
