@@ -10,7 +10,7 @@ use patch_map::AnyMap;
 use roadmap::{
     AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
     MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
-    RrtConnect,
+    RrtConnect, ShortcutConfig, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -22,6 +22,8 @@ pub enum PlannerChoice {
     Rrt,
     /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
     Prm,
+    /// PRM* (Karaman and Frazzoli 2011): ⌈e(1 + 1/3) ln n⌉ nearest neighbours, cycles kept.
+    PrmStar,
     /// RRT-Connect (Kuffner and LaValle 2000), one goal.
     RrtConnect,
     /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
@@ -72,6 +74,9 @@ pub struct PlanArgs {
     /// Write the path to the first goal as an OBJ polyline.
     #[arg(long, conflicts_with = "problem")]
     pub path_out: Option<PathBuf>,
+    /// Also shortcut every path (greedy pass and 100 random attempts) and report it.
+    #[arg(long, conflicts_with = "problem")]
+    pub shortcut: bool,
     #[command(flatten)]
     pub problem: crate::problem::ProblemArgs,
 }
@@ -150,6 +155,20 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
                     m.steep_turns,
                     m.curviness.to_degrees()
                 )?;
+                if args.shortcut {
+                    let short =
+                        shortcut_path(&map, &path, radius, &ShortcutConfig::standard(), args.seed);
+                    let m = PathMetrics::of(&short);
+                    writeln!(
+                        out,
+                        "        shortcut: {} vertices, {:.3} m, {} turns ({} steep), curviness {:.1}°",
+                        short.len(),
+                        m.length,
+                        m.turns,
+                        m.steep_turns,
+                        m.curviness.to_degrees()
+                    )?;
+                }
             }
             None => writeln!(
                 out,
@@ -195,6 +214,10 @@ pub(crate) fn make_planner(
     Ok(match choice {
         PlannerChoice::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
         PlannerChoice::Prm => Box::new(Prm::new(map, space, prm_config(), seed)),
+        PlannerChoice::PrmStar => {
+            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
+            Box::new(Prm::new(map, space, config, seed))
+        }
         PlannerChoice::RrtConnect => {
             if num_goals > 1 {
                 bail!("rrt-connect plans to exactly one --goal");

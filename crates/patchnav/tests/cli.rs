@@ -390,6 +390,32 @@ fn plan_reaches_goals_deterministically_and_writes_obj_lines() {
             path.to_str().unwrap(),
         ])
     };
+    let shortcut = patchnav(&[
+        "plan",
+        map.to_str().unwrap(),
+        "--start",
+        "0.5,2.5,1",
+        "--goal",
+        "3.5,0.5,0.5",
+        "--radius",
+        "0.2",
+        "--step",
+        "0.5",
+        "--shortcut",
+    ]);
+    assert!(shortcut.status.success(), "{}", stderr(&shortcut));
+    let text = stdout(&shortcut);
+    let metres = |line: &str| -> f64 {
+        line.split(", ")
+            .find(|p| p.ends_with(" m"))
+            .unwrap()
+            .trim_end_matches(" m")
+            .parse()
+            .unwrap()
+    };
+    let raw = text.lines().find(|l| l.starts_with("goal 0")).unwrap();
+    let short = text.lines().find(|l| l.trim_start().starts_with("shortcut:")).unwrap();
+    assert!(metres(short) <= metres(raw) + 1e-9, "{text}");
     let first = plan("7");
     assert!(first.status.success(), "{}", stderr(&first));
     let text = stdout(&first);
@@ -456,7 +482,7 @@ fn plan_offers_rrt_connect_and_evasion_rrt_where_the_map_allows() {
         args.extend(["--step", "0.5", "--planner", planner]);
         patchnav(&args)
     };
-    for planner in ["rrt-connect", "evasion-rrt", "prm"] {
+    for planner in ["rrt-connect", "evasion-rrt", "prm", "prm-star"] {
         let o = plan(&map, planner, &["3.5,2.5,1.5"]);
         assert!(o.status.success(), "{planner}: {}", stderr(&o));
         assert_eq!(info_field(&stdout(&o), "status"), "Exact", "{planner}: {}", stdout(&o));
