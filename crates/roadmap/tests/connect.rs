@@ -4,82 +4,20 @@
 use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies;
 use patch_core::{
-    Aabb, BruteForceMap, CapsuleStep, Counted, FromPatches, PlanarPatch, Point3, Real,
-    UnspecificStepIntersector,
+    BruteForceMap, CapsuleStep, Counted, FromPatches, Point3, Real, UnspecificStepIntersector,
 };
 use petgraph::algo::is_cyclic_undirected;
-use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlannerStatus, PlanningSpace, Problem,
-    Roadmap, RrtConnect, Termination,
+    Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace, Problem, RrtConnect, Termination,
 };
 
-const RADIUS: Real = 0.2;
-
-fn space(max_step: Real) -> PlanningSpace {
-    let room = Aabb::new(Point3::origin(), Point3::new(6.0, 4.0, 2.5));
-    PlanningSpace::new(room, RADIUS, max_step).unwrap()
-}
-
-/// A wall at x = 3 across the room with a door off the straight line start → goal.
-fn wall_with_door() -> BruteForceMap {
-    let x = 3.0;
-    let outer = [
-        Point3::new(x, 0.0, 0.0),
-        Point3::new(x, 4.0, 0.0),
-        Point3::new(x, 4.0, 2.5),
-        Point3::new(x, 0.0, 2.5),
-    ];
-    let hole = vec![
-        Point3::new(x, 0.5, 0.5),
-        Point3::new(x, 1.5, 0.5),
-        Point3::new(x, 1.5, 2.0),
-        Point3::new(x, 0.5, 2.0),
-    ];
-    let wall = PlanarPatch::from_world_polygon(&outer, &[hole], 1e-9).unwrap();
-    BruteForceMap::from_patches([wall.into()]).unwrap()
-}
-
-fn across() -> Problem {
-    Problem {
-        start: Point3::new(1.0, 2.0, 1.25),
-        goals: vec![Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.0 }],
-    }
-}
-
-fn until_solved(k: u64) -> AnyOf<GoalReached, MaxIterations> {
-    AnyOf(GoalReached, MaxIterations(k))
-}
-
-fn assert_all_free(map: &BruteForceMap, planner: &dyn Planner) {
-    let graph = planner.roadmap();
-    for e in graph.edge_references() {
-        let (a, b) = (graph[e.source()], graph[e.target()]);
-        let step = CapsuleStep::new(a, b, RADIUS).unwrap();
-        assert!(map.is_step_free(&step), "roadmap edge {a} → {b} collides");
-        assert!((e.weight() - (b - a).norm()).abs() < 1e-12, "edge weight is its length");
-    }
-    if let Some(path) = planner.path_to(0) {
-        for w in path.windows(2) {
-            let step = CapsuleStep::new(w[0], w[1], RADIUS).unwrap();
-            assert!(map.is_step_free(&step), "path edge {} → {} collides", w[0], w[1]);
-        }
-    }
-}
-
-fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
-    let nodes = a.node_weights().eq(b.node_weights());
-    let edges = a
-        .edge_references()
-        .map(|e| (e.source(), e.target(), *e.weight()))
-        .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
-    nodes && edges
-}
+mod common;
+use common::*;
 
 #[test]
 fn joins_the_trees_across_an_empty_room_and_through_the_door() {
-    let problem = across();
+    let problem = across(0.0);
     for map in [BruteForceMap::new(), wall_with_door()] {
         for seed in 0..3 {
             let mut p = RrtConnect::new(&map, space(0.5), seed);
@@ -88,7 +26,7 @@ fn joins_the_trees_across_an_empty_room_and_through_the_door() {
             assert_eq!(path[0], problem.start);
             assert_eq!(path.last(), Some(&problem.goals[0].center));
             assert!(path.windows(2).all(|w| (w[1] - w[0]).norm() <= 0.5 + 1e-12));
-            assert_all_free(&map, &p);
+            assert_all_free(&map, &p, 1);
             assert!(!is_cyclic_undirected(p.roadmap()));
             assert_eq!(p.roadmap().edge_count(), p.roadmap().node_count() - 1, "one tree");
         }
@@ -103,7 +41,7 @@ fn joins_the_trees_across_an_empty_room_and_through_the_door() {
 #[test]
 fn goals_start_and_termination() {
     let map = wall_with_door();
-    let problem = across();
+    let problem = across(0.0);
     let mut p = RrtConnect::new(&map, space(0.5), 1);
     assert_eq!(p.name(), "rrt-connect");
     let two = Problem { goals: vec![problem.goals[0]; 2], ..problem.clone() };
@@ -156,7 +94,7 @@ impl Termination for Recorder {
 #[test]
 fn determinism_counters_and_termination() {
     let counted = Counted::new(wall_with_door());
-    let problem = across();
+    let problem = across(0.0);
     let run = |seed: u64| {
         counted.reset_counts();
         let mut p = RrtConnect::new(&counted, space(0.5), seed);
@@ -191,7 +129,7 @@ proptest! {
         let problem = Problem { start, goals: vec![Goal { center: goal, tolerance }] };
         let mut p = RrtConnect::new(&map, space, seed);
         let status = p.solve(&problem, &mut MaxIterations(60));
-        assert_all_free(&map, &p);
+        assert_all_free(&map, &p, 1);
         let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
         prop_assert_eq!(status == PlannerStatus::InvalidStart, !sphere_free(start));
         if sphere_free(start) {

@@ -4,47 +4,22 @@
 use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies;
 use patch_core::{
-    Aabb, BruteForceMap, CapsuleStep, Counted, FromPatches, PlanarPatch, Point3, ProximityQuery,
-    Real, SpecificStepIntersector, UnspecificStepIntersector,
+    BruteForceMap, CapsuleStep, Counted, FromPatches, PlanarPatch, Point3, ProximityQuery, Real,
+    SpecificStepIntersector, UnspecificStepIntersector,
 };
 use petgraph::algo::is_cyclic_undirected;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaxIterations, Planner, PlannerStatus,
-    PlanningSpace, Problem, Roadmap, Rrt, RrtConfig,
+    EvasionRrt, EvasionRrtConfig, Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace,
+    Problem, Roadmap, Rrt, RrtConfig,
 };
 
-const RADIUS: Real = 0.2;
-
-fn room() -> Aabb {
-    Aabb::new(Point3::origin(), Point3::new(6.0, 4.0, 2.5))
-}
-
-fn space(max_step: Real) -> PlanningSpace {
-    PlanningSpace::new(room(), RADIUS, max_step).unwrap()
-}
+mod common;
+use common::*;
 
 fn quad(corners: [Point3; 4], holes: Vec<Vec<Point3>>) -> PlanarPatch {
     PlanarPatch::from_world_polygon(&corners, &holes, 1e-9).unwrap()
-}
-
-/// A wall at x = 3 across the room with a door off the straight line start → goal.
-fn wall_with_door() -> BruteForceMap {
-    let x = 3.0;
-    let outer = [
-        Point3::new(x, 0.0, 0.0),
-        Point3::new(x, 4.0, 0.0),
-        Point3::new(x, 4.0, 2.5),
-        Point3::new(x, 0.0, 2.5),
-    ];
-    let hole = vec![
-        Point3::new(x, 0.5, 0.5),
-        Point3::new(x, 1.5, 0.5),
-        Point3::new(x, 1.5, 2.0),
-        Point3::new(x, 0.5, 2.0),
-    ];
-    BruteForceMap::from_patches([quad(outer, vec![hole]).into()]).unwrap()
 }
 
 /// A 1.2 m × 1.2 m plate at x = 3 in the middle of the room, across the straight line.
@@ -59,44 +34,8 @@ fn plate() -> BruteForceMap {
     BruteForceMap::from_patches([quad(outer, vec![]).into()]).unwrap()
 }
 
-fn across() -> Problem {
-    Problem {
-        start: Point3::new(1.0, 2.0, 1.25),
-        goals: vec![Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.3 }],
-    }
-}
-
-fn until_solved(k: u64) -> AnyOf<GoalReached, MaxIterations> {
-    AnyOf(GoalReached, MaxIterations(k))
-}
-
 fn config(space: &PlanningSpace) -> EvasionRrtConfig {
     EvasionRrtConfig::for_space(space)
-}
-
-fn assert_all_free(map: &BruteForceMap, planner: &dyn Planner) {
-    let graph = planner.roadmap();
-    for e in graph.edge_references() {
-        let (a, b) = (graph[e.source()], graph[e.target()]);
-        let step = CapsuleStep::new(a, b, RADIUS).unwrap();
-        assert!(map.is_step_free(&step), "roadmap edge {a} → {b} collides");
-        assert!((e.weight() - (b - a).norm()).abs() < 1e-12, "edge weight is its length");
-    }
-    if let Some(path) = planner.path_to(0) {
-        for w in path.windows(2) {
-            let step = CapsuleStep::new(w[0], w[1], RADIUS).unwrap();
-            assert!(map.is_step_free(&step), "path edge {} → {} collides", w[0], w[1]);
-        }
-    }
-}
-
-fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
-    let nodes = a.node_weights().eq(b.node_weights());
-    let edges = a
-        .edge_references()
-        .map(|e| (e.source(), e.target(), *e.weight()))
-        .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
-    nodes && edges
 }
 
 /// The planner accepts maps with the specific capsule query (the negative case, a map with
@@ -111,13 +50,13 @@ fn accepts_specific_intersectors() {
     assert_impl(&&map);
     let dynamic: &dyn SpecificStepIntersector<CapsuleStep> = &map;
     let mut p = EvasionRrt::new(dynamic, space(0.5), config(&space(0.5)), 0);
-    assert_eq!(p.solve(&across(), &mut until_solved(5_000)), PlannerStatus::Exact);
+    assert_eq!(p.solve(&across(0.3), &mut until_solved(5_000)), PlannerStatus::Exact);
     assert_eq!(p.name(), "evasion-rrt");
 }
 
 #[test]
 fn crosses_the_room_and_finds_the_door() {
-    let problem = across();
+    let problem = across(0.3);
     for map in [BruteForceMap::new(), wall_with_door(), plate()] {
         for seed in 0..3 {
             let mut p = EvasionRrt::new(&map, space(0.5), config(&space(0.5)), seed);
@@ -125,7 +64,7 @@ fn crosses_the_room_and_finds_the_door() {
             let path = p.path_to(0).unwrap();
             assert_eq!(path[0], problem.start);
             assert!((path.last().unwrap() - problem.goals[0].center).norm() <= 0.3);
-            assert_all_free(&map, &p);
+            assert_all_free(&map, &p, 1);
             assert!(!is_cyclic_undirected(p.roadmap()));
         }
     }
@@ -134,7 +73,7 @@ fn crosses_the_room_and_finds_the_door() {
 #[test]
 fn same_seed_same_roadmap() {
     let map = plate();
-    let problem = across();
+    let problem = across(0.3);
     let run = |seed: u64| {
         let mut p = EvasionRrt::new(&map, space(0.5), config(&space(0.5)), seed);
         p.solve(&problem, &mut MaxIterations(500));
@@ -152,7 +91,7 @@ fn same_seed_same_roadmap() {
 /// Without shifts the Evasion RRT is the RRT: same seed, same roadmap.
 #[test]
 fn without_evasion_it_is_the_rrt() {
-    let problem = across();
+    let problem = across(0.3);
     for map in [wall_with_door(), plate()] {
         for seed in 0..3 {
             let mut rrt = Rrt::new(&map, space(0.5), RrtConfig::thesis(), seed);
@@ -174,14 +113,14 @@ fn without_evasion_it_is_the_rrt() {
 #[test]
 fn collisions_are_evaded_along_the_plate() {
     let map = plate();
-    let problem = across();
+    let problem = across(0.3);
     let cfg = config(&space(0.5));
     let bound = (0.5 as Real).hypot(Real::from(cfg.max_evasions) * cfg.evasion_step) + 1e-9;
     for seed in 0..4 {
         let mut p = EvasionRrt::new(&map, space(0.5), cfg, seed);
         p.solve(&problem, &mut MaxIterations(2_000));
         assert!(p.evaded_vertices() > 0, "seed {seed}: no vertex came from an evasion");
-        assert_all_free(&map, &p);
+        assert_all_free(&map, &p, 1);
         let graph = p.roadmap();
         let longest = graph.edge_references().map(|e| *e.weight()).fold(0.0, Real::max);
         assert!(longest > 0.5 + 1e-9, "an evaded edge is longer than the step");
@@ -197,7 +136,7 @@ fn collisions_are_evaded_along_the_plate() {
 #[test]
 fn vertices_gather_near_obstacles() {
     let map = plate();
-    let problem = Problem { start: across().start, goals: vec![] };
+    let problem = Problem { start: across(0.3).start, goals: vec![] };
     let mean_clearance = |g: &Roadmap| {
         let sum: Real = g.node_weights().map(|p| map.clearance(p, Real::INFINITY)).sum();
         sum / g.node_count() as Real
@@ -220,7 +159,7 @@ fn vertices_gather_near_obstacles() {
 #[test]
 fn counters_count_specific_checks() {
     let counted = Counted::new(plate());
-    let problem = across();
+    let problem = across(0.3);
     for direct in [false, true] {
         counted.reset_counts();
         let mut cfg = config(&space(0.5));
@@ -251,9 +190,9 @@ fn invalid_starts_and_goals() {
         assert_eq!(p.roadmap().node_count(), 0);
     }
     let bad = Goal { center: Point3::new(3.1, 3.0, 1.25), tolerance: 0.3 };
-    let problem = Problem { start: across().start, goals: vec![goal, bad] };
+    let problem = Problem { start: across(0.3).start, goals: vec![goal, bad] };
     assert_eq!(p.solve(&problem, &mut MaxIterations(10)), PlannerStatus::InvalidGoal);
-    assert_eq!(p.solve(&across(), &mut MaxIterations(0)), PlannerStatus::Timeout);
+    assert_eq!(p.solve(&across(0.3), &mut MaxIterations(0)), PlannerStatus::Timeout);
 }
 
 proptest! {
@@ -276,7 +215,7 @@ proptest! {
         let cfg = EvasionRrtConfig { rrt, evasion_step, max_evasions };
         let mut p = EvasionRrt::new(&map, space, cfg, seed);
         let status = p.solve(&problem, &mut MaxIterations(60));
-        assert_all_free(&map, &p);
+        assert_all_free(&map, &p, 1);
         let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
         prop_assert_eq!(status == PlannerStatus::InvalidStart, !sphere_free(start));
         prop_assert_eq!(status == PlannerStatus::Exact, p.path_to(0).is_some());

@@ -9,14 +9,14 @@ use patch_core::{
     Real, UnspecificStepIntersector,
 };
 use petgraph::algo::is_cyclic_undirected;
-use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, MaxIterations, Planner,
-    PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Roadmap,
+    Goal, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, MaxIterations, Planner, PlannerStatus,
+    PlanningSpace, Prm, PrmConfig, Problem, Roadmap,
 };
 
-const RADIUS: Real = 0.2;
+mod common;
+use common::*;
 
 /// The corridor's inside: 10 m long, 2 m wide, 1.5 m high.
 fn corridor_box() -> Aabb {
@@ -47,35 +47,6 @@ fn along_the_corridor() -> Problem {
         start: Point3::new(0.5, 1.0, 0.75),
         goals: vec![Goal { center: Point3::new(9.5, 1.0, 0.75), tolerance: 0.3 }],
     }
-}
-
-fn until_solved(k: u64) -> AnyOf<GoalReached, MaxIterations> {
-    AnyOf(GoalReached, MaxIterations(k))
-}
-
-fn assert_all_free(map: &BruteForceMap, planner: &dyn Planner) {
-    let graph = planner.roadmap();
-    for e in graph.edge_references() {
-        let (a, b) = (graph[e.source()], graph[e.target()]);
-        let step = CapsuleStep::new(a, b, RADIUS).unwrap();
-        assert!(map.is_step_free(&step), "roadmap edge {a} → {b} collides");
-        assert!((e.weight() - (b - a).norm()).abs() < 1e-12, "edge weight is its length");
-    }
-    if let Some(path) = planner.path_to(0) {
-        for w in path.windows(2) {
-            let step = CapsuleStep::new(w[0], w[1], RADIUS).unwrap();
-            assert!(map.is_step_free(&step), "path edge {} → {} collides", w[0], w[1]);
-        }
-    }
-}
-
-fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
-    let nodes = a.node_weights().eq(b.node_weights());
-    let edges = a
-        .edge_references()
-        .map(|e| (e.source(), e.target(), *e.weight()))
-        .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
-    nodes && edges
 }
 
 /// The corridor's medial axis: equally far from the two closest of its four walls.
@@ -118,7 +89,7 @@ fn ma_prm_vertices_lie_on_the_medial_axis_and_connect_the_corridor() {
     for seed in 0..3 {
         let mut p = MaPrm::new(&map, s, config, seed);
         assert_eq!(p.solve(&problem, &mut until_solved(5_000)), PlannerStatus::Exact);
-        assert_all_free(&map, &p);
+        assert_all_free(&map, &p, 1);
         let graph = p.roadmap();
         assert!(!is_cyclic_undirected(graph));
         // Every vertex but the start is a retracted sample (no direct goal step).
@@ -138,7 +109,7 @@ fn ma_rrt_crosses_the_corridor() {
     for seed in 0..3 {
         let mut p = MaRrt::new(&map, s, MaRrtConfig::for_space(&s), seed);
         assert_eq!(p.solve(&along_the_corridor(), &mut until_solved(5_000)), PlannerStatus::Exact);
-        assert_all_free(&map, &p);
+        assert_all_free(&map, &p, 1);
         let path = p.path_to(0).unwrap();
         assert_eq!(path[0], along_the_corridor().start);
         assert!(!is_cyclic_undirected(p.roadmap()));
@@ -192,7 +163,7 @@ fn dropped_samples_count_as_iterations() {
     config.rrt.goal_bias = 0.2;
     let mut biased = MaRrt::new(&map, s, config, 3);
     assert_eq!(biased.solve(&problem, &mut until_solved(5_000)), PlannerStatus::Exact);
-    assert_all_free(&map, &biased);
+    assert_all_free(&map, &biased, 1);
 }
 
 #[test]
@@ -257,7 +228,7 @@ proptest! {
         let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
         for mut p in planners {
             let status = p.solve(&problem, &mut MaxIterations(60));
-            assert_all_free(&map, p.as_ref());
+            assert_all_free(&map, p.as_ref(), 1);
             prop_assert_eq!(status == PlannerStatus::InvalidStart, !sphere_free(start));
             prop_assert_eq!(status == PlannerStatus::Exact, p.path_to(0).is_some());
             if let Some(path) = p.path_to(0) {

@@ -4,8 +4,7 @@
 use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies;
 use patch_core::{
-    Aabb, BruteForceMap, CapsuleStep, Counted, FromPatches, PlanarPatch, Point3, Real,
-    UnspecificStepIntersector,
+    BruteForceMap, CapsuleStep, Counted, FromPatches, Point3, Real, UnspecificStepIntersector,
 };
 use petgraph::algo::is_cyclic_undirected;
 use petgraph::visit::EdgeRef;
@@ -15,80 +14,13 @@ use roadmap::{
     Problem, Roadmap, Rrt, RrtConfig, Sampler, Termination,
 };
 
-const RADIUS: Real = 0.2;
-
-/// A 6 m × 4 m × 2.5 m box.
-fn room() -> Aabb {
-    Aabb::new(Point3::origin(), Point3::new(6.0, 4.0, 2.5))
-}
-
-fn space(max_step: Real) -> PlanningSpace {
-    PlanningSpace::new(room(), RADIUS, max_step).unwrap()
-}
-
-/// A wall at x = 3 filling the room's cross-section, with a 1 m × 1.5 m opening off the
-/// straight line of [`across_the_wall`].
-fn wall_with_door() -> BruteForceMap {
-    let x = 3.0;
-    let outer = [
-        Point3::new(x, 0.0, 0.0),
-        Point3::new(x, 4.0, 0.0),
-        Point3::new(x, 4.0, 2.5),
-        Point3::new(x, 0.0, 2.5),
-    ];
-    let hole = vec![
-        Point3::new(x, 0.5, 0.5),
-        Point3::new(x, 1.5, 0.5),
-        Point3::new(x, 1.5, 2.0),
-        Point3::new(x, 0.5, 2.0),
-    ];
-    let wall = PlanarPatch::from_world_polygon(&outer, &[hole], 1e-9).unwrap();
-    BruteForceMap::from_patches([wall.into()]).unwrap()
-}
-
-fn across_the_wall() -> Problem {
-    Problem {
-        start: Point3::new(1.0, 2.0, 1.25),
-        goals: vec![Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.3 }],
-    }
-}
-
-fn until_solved(k: u64) -> AnyOf<GoalReached, MaxIterations> {
-    AnyOf(GoalReached, MaxIterations(k))
-}
-
-/// Every edge of the roadmap and of every returned path is free for the reference map.
-fn assert_all_free(map: &BruteForceMap, planner: &dyn Planner, goals: usize) {
-    let graph = planner.roadmap();
-    for e in graph.edge_references() {
-        let (a, b) = (graph[e.source()], graph[e.target()]);
-        let step = CapsuleStep::new(a, b, RADIUS).unwrap();
-        assert!(map.is_step_free(&step), "roadmap edge {a} → {b} collides");
-        assert!((e.weight() - (b - a).norm()).abs() < 1e-12, "edge weight is its length");
-    }
-    for g in 0..goals {
-        if let Some(path) = planner.path_to(g) {
-            for w in path.windows(2) {
-                let step = CapsuleStep::new(w[0], w[1], RADIUS).unwrap();
-                assert!(map.is_step_free(&step), "path edge {} → {} collides", w[0], w[1]);
-            }
-        }
-    }
-}
-
-fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
-    let nodes = a.node_weights().eq(b.node_weights());
-    let edges = a
-        .edge_references()
-        .map(|e| (e.source(), e.target(), *e.weight()))
-        .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
-    nodes && edges
-}
+mod common;
+use common::*;
 
 #[test]
 fn rrt_and_prm_cross_an_empty_room() {
     let map = BruteForceMap::new();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let mut rrt = Rrt::new(&map, space(0.5), RrtConfig::thesis(), 1);
     assert_eq!(rrt.solve(&problem, &mut until_solved(5_000)), PlannerStatus::Exact);
     let path = rrt.path_to(0).unwrap();
@@ -105,7 +37,7 @@ fn rrt_and_prm_cross_an_empty_room() {
 #[test]
 fn rrt_and_prm_find_the_door() {
     let map = wall_with_door();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let straight = CapsuleStep::new(problem.start, problem.goals[0].center, RADIUS).unwrap();
     assert!(!map.is_step_free(&straight));
     for seed in 0..3 {
@@ -125,7 +57,7 @@ fn rrt_and_prm_find_the_door() {
 #[test]
 fn lesum_rrt_steps_straight_to_a_visible_goal() {
     let map = BruteForceMap::new();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let mut rrt = Rrt::new(&map, space(0.5), RrtConfig::lesum(None), 4);
     assert_eq!(rrt.solve(&problem, &mut until_solved(100)), PlannerStatus::Exact);
     assert_eq!(rrt.path_to(0).unwrap(), vec![problem.start, problem.goals[0].center]);
@@ -188,7 +120,7 @@ fn planners(map: &BruteForceMap, seed: u64) -> Vec<Box<dyn Planner + '_>> {
 #[test]
 fn termination_and_status() {
     let map = wall_with_door();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     for mut planner in planners(&map, 5) {
         assert_eq!(planner.solve(&problem, &mut MaxIterations(0)), PlannerStatus::Timeout);
         let now = roadmap::Deadline(std::time::Instant::now());
@@ -227,7 +159,7 @@ fn termination_and_status() {
 #[test]
 fn counters_match_a_counted_map() {
     let counted = Counted::new(wall_with_door());
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let mut rrt = Rrt::new(&counted, space(0.5), RrtConfig::thesis(), 2);
     rrt.solve(&problem, &mut MaxIterations(300));
     let c = rrt.counters();
@@ -258,7 +190,7 @@ fn planners_accept_any_capsule_intersector() {
     let counted = Counted::new(BruteForceMap::new());
     let by_ref = &map;
     let dynamic: &dyn UnspecificStepIntersector<CapsuleStep> = &map;
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let mut all = takes(&map);
     all.extend(takes(&counted));
     all.extend(takes(&by_ref));
@@ -271,7 +203,7 @@ fn planners_accept_any_capsule_intersector() {
 #[test]
 fn same_seed_same_roadmap() {
     let map = wall_with_door();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     let stop = || MaxIterations(400);
     let mut config = RrtConfig::lesum(Some(4e3));
     config.goal_bias = 0.1;
@@ -310,7 +242,7 @@ impl Termination for Recorder {
 #[test]
 fn termination_is_asked_before_every_iteration() {
     let map = BruteForceMap::new();
-    let problem = across_the_wall();
+    let problem = across(0.3);
     for mut p in planners(&map, 0) {
         let mut rec = Recorder(Vec::new(), 5);
         p.solve(&problem, &mut rec);

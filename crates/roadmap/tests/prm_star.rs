@@ -3,10 +3,7 @@
 
 use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies;
-use patch_core::{
-    Aabb, BruteForceMap, CapsuleStep, FromPatches, PlanarPatch, Point3, Real,
-    UnspecificStepIntersector,
-};
+use patch_core::{BruteForceMap, CapsuleStep, FromPatches, Real, UnspecificStepIntersector};
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::metrics::path_length;
@@ -15,37 +12,8 @@ use roadmap::{
     Problem,
 };
 
-const RADIUS: Real = 0.2;
-
-fn room() -> PlanningSpace {
-    PlanningSpace::new(Aabb::new(Point3::origin(), Point3::new(6.0, 4.0, 2.5)), RADIUS, 0.5)
-        .unwrap()
-}
-
-fn problem() -> Problem {
-    Problem {
-        start: Point3::new(1.0, 2.0, 1.25),
-        goals: vec![Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.3 }],
-    }
-}
-
-fn wall_with_door() -> BruteForceMap {
-    let x = 3.0;
-    let outer = [
-        Point3::new(x, 0.0, 0.0),
-        Point3::new(x, 4.0, 0.0),
-        Point3::new(x, 4.0, 2.5),
-        Point3::new(x, 0.0, 2.5),
-    ];
-    let hole = vec![
-        Point3::new(x, 0.5, 0.5),
-        Point3::new(x, 1.5, 0.5),
-        Point3::new(x, 1.5, 2.0),
-        Point3::new(x, 0.5, 2.0),
-    ];
-    let wall = PlanarPatch::from_world_polygon(&outer, &[hole], 1e-9).unwrap();
-    BruteForceMap::from_patches([wall.into()]).unwrap()
-}
+mod common;
+use common::*;
 
 fn assert_edges_free(map: &BruteForceMap, prm: &dyn Planner) {
     let graph = prm.roadmap();
@@ -86,8 +54,8 @@ fn in_an_empty_room_every_sample_connects_to_k_of_n_neighbours() {
     let map = BruteForceMap::new();
     let config = PrmConfig::star();
     let samples = 300;
-    let mut prm = Prm::new(&map, room(), config, 4);
-    prm.solve(&problem(), &mut MaxIterations(samples));
+    let mut prm = Prm::new(&map, space(0.5), config, 4);
+    prm.solve(&across(0.3), &mut MaxIterations(samples));
     let vertices = prm.roadmap().node_count();
     assert_eq!(vertices, samples as usize + 1);
     let expected: usize = (2..=vertices).map(|n| config.neighbours_for(n).min(n - 1)).sum();
@@ -99,16 +67,16 @@ fn in_an_empty_room_every_sample_connects_to_k_of_n_neighbours() {
 #[test]
 fn prm_star_crosses_the_door_with_free_edges_and_a_shortest_path() {
     let map = wall_with_door();
-    let mut prm = Prm::new(&map, room(), PrmConfig::star(), 2);
-    let status = prm.solve(&problem(), &mut AnyOf(GoalReached, MaxIterations(5_000)));
+    let mut prm = Prm::new(&map, space(0.5), PrmConfig::star(), 2);
+    let status = prm.solve(&across(0.3), &mut AnyOf(GoalReached, MaxIterations(5_000)));
     assert_eq!(status, PlannerStatus::Exact);
     assert_edges_free(&map, &prm);
     let path = prm.path_to(0).unwrap();
-    assert_eq!(path[0], problem().start);
-    assert!((path.last().unwrap() - problem().goals[0].center).norm() <= 0.3);
+    assert_eq!(path[0], across(0.3).start);
+    assert!((path.last().unwrap() - across(0.3).goals[0].center).norm() <= 0.3);
     // Deterministic for a seed.
-    let mut again = Prm::new(&map, room(), PrmConfig::star(), 2);
-    again.solve(&problem(), &mut AnyOf(GoalReached, MaxIterations(5_000)));
+    let mut again = Prm::new(&map, space(0.5), PrmConfig::star(), 2);
+    again.solve(&across(0.3), &mut AnyOf(GoalReached, MaxIterations(5_000)));
     assert_eq!(again.path_to(0).unwrap(), path);
 }
 
@@ -116,8 +84,8 @@ fn prm_star_crosses_the_door_with_free_edges_and_a_shortest_path() {
 fn paths_are_shortest_in_the_roadmap() {
     // Growing past the goal, PRM*'s roadmap has cycles; the path is Dijkstra's.
     let map = BruteForceMap::new();
-    let mut prm = Prm::new(&map, room(), PrmConfig::star(), 8);
-    prm.solve(&problem(), &mut MaxIterations(400));
+    let mut prm = Prm::new(&map, space(0.5), PrmConfig::star(), 8);
+    prm.solve(&across(0.3), &mut MaxIterations(400));
     let graph = prm.roadmap();
     assert!(petgraph::algo::is_cyclic_undirected(graph));
     let path = prm.path_to(0).unwrap();

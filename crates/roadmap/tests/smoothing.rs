@@ -4,8 +4,7 @@
 use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies;
 use patch_core::{
-    Aabb, BruteForceMap, CapsuleStep, FromPatches, PlanarPatch, Point3, Real,
-    UnspecificStepIntersector,
+    Aabb, BruteForceMap, CapsuleStep, FromPatches, Point3, UnspecificStepIntersector,
 };
 use proptest::prelude::*;
 use roadmap::metrics::path_length;
@@ -14,29 +13,11 @@ use roadmap::{
     RrtConfig, ShortcutConfig, shortcut_path,
 };
 
-const RADIUS: Real = 0.2;
+mod common;
+use common::*;
 
 fn is_free(map: &BruteForceMap, a: Point3, b: Point3) -> bool {
     map.is_step_free(&CapsuleStep::new(a, b, RADIUS).unwrap())
-}
-
-/// A wall at x = 3 across a 6 m × 4 m × 2.5 m room with a door at 0.5 ≤ y ≤ 1.5.
-fn wall_with_door() -> BruteForceMap {
-    let x = 3.0;
-    let outer = [
-        Point3::new(x, 0.0, 0.0),
-        Point3::new(x, 4.0, 0.0),
-        Point3::new(x, 4.0, 2.5),
-        Point3::new(x, 0.0, 2.5),
-    ];
-    let hole = vec![
-        Point3::new(x, 0.5, 0.5),
-        Point3::new(x, 1.5, 0.5),
-        Point3::new(x, 1.5, 2.0),
-        Point3::new(x, 0.5, 2.0),
-    ];
-    let wall = PlanarPatch::from_world_polygon(&outer, &[hole], 1e-9).unwrap();
-    BruteForceMap::from_patches([wall.into()]).unwrap()
 }
 
 /// The result's ends, segments and length, checked against the input.
