@@ -3,10 +3,12 @@
 
 use pointcloud::io::pcd::{PcdEncoding, PcdWriteOptions, read_pcd, write_pcd};
 use pointcloud::io::{Error, ErrorKind, Position, Precision, ReadOptions};
-use pointcloud::na::UnitQuaternion;
-use pointcloud::{FieldData, Isometry3, Point3, PointCloud, ScalarField, SensorPose, Vector3};
+use pointcloud::{FieldData, Point3, PointCloud, ScalarField, Vector3};
 use proptest::collection::vec;
 use proptest::prelude::*;
+
+mod common;
+use common::*;
 
 fn read(bytes: &[u8]) -> Result<PointCloud, Error> {
     read_pcd(bytes, &ReadOptions::STRICT)
@@ -439,29 +441,6 @@ fn writer_refuses_padding_and_repeated_names() {
 // ---------------------------------------------------------------------------------------------
 // Round trips of random clouds
 
-fn finite_f32() -> impl Strategy<Value = f32> {
-    use proptest::num::f32::*;
-    POSITIVE | NEGATIVE | NORMAL | SUBNORMAL | ZERO
-}
-
-fn finite_f64() -> impl Strategy<Value = f64> {
-    use proptest::num::f64::*;
-    POSITIVE | NEGATIVE | NORMAL | SUBNORMAL | ZERO
-}
-
-fn field_data(n: usize) -> impl Strategy<Value = FieldData> {
-    prop_oneof![
-        vec(any::<i8>(), n).prop_map(FieldData::I8),
-        vec(any::<u8>(), n).prop_map(FieldData::U8),
-        vec(any::<i16>(), n).prop_map(FieldData::I16),
-        vec(any::<u16>(), n).prop_map(FieldData::U16),
-        vec(any::<i32>(), n).prop_map(FieldData::I32),
-        vec(any::<u32>(), n).prop_map(FieldData::U32),
-        vec(finite_f32(), n).prop_map(FieldData::F32),
-        vec(finite_f64(), n).prop_map(FieldData::F64),
-    ]
-}
-
 /// `None` for an unorganised cloud, else the image size (at least two rows: PCD's `HEIGHT 1` is
 /// an unorganised cloud); `mask` says which records are valid.
 fn layout() -> impl Strategy<Value = (Option<(u32, u32)>, Vec<bool>)> {
@@ -471,19 +450,6 @@ fn layout() -> impl Strategy<Value = (Option<(u32, u32)>, Vec<bool>)> {
             vec(prop::bool::weighted(0.7), (w * h) as usize).prop_map(move |m| (Some((w, h)), m))
         }),
     ]
-}
-
-fn pose() -> impl Strategy<Value = SensorPose> {
-    let angle = -3.2f64..3.2;
-    (vec(-100.0f64..100.0, 3), angle.clone(), angle.clone(), angle).prop_map(|(t, r, p, y)| {
-        let rotation = UnitQuaternion::from_euler_angles(r, p, y);
-        SensorPose {
-            world_from_sensor: Isometry3::from_parts(
-                Vector3::new(t[0], t[1], t[2]).into(),
-                rotation,
-            ),
-        }
-    })
 }
 
 prop_compose! {
