@@ -8,6 +8,7 @@
 //! patchnav map info MAP
 //! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]
 //! patchnav plan --problem P.json --backend B --planner X --mode explore|solve|roi
+//! patchnav experiment office|lab-timing|lab-volume ...
 //! ```
 //!
 //! Errors are printed as one line on standard error and the exit code is 1 (2 for usage errors,
@@ -18,6 +19,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod convert;
+mod experiment;
 mod info;
 mod input;
 mod map;
@@ -62,6 +64,9 @@ enum Command {
     Map(map::MapCommand),
     /// Plan on a map file with RRT or PRM.
     Plan(plan::PlanArgs),
+    /// Run the thesis's planning experiments and print our numbers beside the thesis's.
+    #[command(subcommand)]
+    Experiment(experiment::ExperimentCommand),
 }
 
 fn main() -> ExitCode {
@@ -75,6 +80,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args, &progress),
         Command::Map(command) => map::run(&command, &progress),
         Command::Plan(args) => plan::run(&args, &progress),
+        Command::Experiment(command) => experiment::run(&command, &progress),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

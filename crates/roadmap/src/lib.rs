@@ -123,6 +123,7 @@ mod rrt;
 pub mod smoothing;
 mod space;
 mod termination;
+pub mod volume;
 
 pub use connect::RrtConnect;
 pub use evasion::{EvasionRrt, EvasionRrtConfig};

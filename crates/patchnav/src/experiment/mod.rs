@@ -1,0 +1,36 @@
+//! `patchnav experiment ...`: the thesis's planning experiments, run on our maps and printed
+//! beside the thesis's numbers.
+//!
+//! * `office`: the preliminary experiment of §5.5.3 (Tables 5.3–5.11);
+//! * `lab-timing`: RRT time against iterations on the lab's planes, hybrid, trimesh and
+//!   point-cloud maps (§6.1.3, Fig 6.4), as CSV and SVG;
+//! * `lab-volume`: explored volume and its congruence tables (§6.1.1, Tables 6.2 and 6.4).
+
+use crate::progress::Progress;
+use anyhow::Result;
+use clap::Subcommand;
+
+mod lab;
+mod office;
+
+/// The experiments.
+#[derive(Subcommand, Debug)]
+pub enum ExperimentCommand {
+    /// Thesis §5.5.3: every planner on every backend, reach four regions of interest from the
+    /// centre of the office floor plan; prints Tables 5.3–5.11 beside the thesis's numbers.
+    Office(office::OfficeArgs),
+    /// Thesis Fig 6.4: RRT time against iterations on the lab's four map types (CSV and SVG).
+    LabTiming(lab::LabTimingArgs),
+    /// Thesis Tables 6.2 and 6.4: explored volume of RRT and PRM on the lab's four map types
+    /// and the congruence table between them.
+    LabVolume(lab::LabVolumeArgs),
+}
+
+/// Runs `patchnav experiment ...`.
+pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
+    match command {
+        ExperimentCommand::Office(args) => office::run(args, progress),
+        ExperimentCommand::LabTiming(args) => lab::run_timing(args, progress),
+        ExperimentCommand::LabVolume(args) => lab::run_volume(args, progress),
+    }
+}
