@@ -26,6 +26,7 @@ mod map;
 mod plan;
 mod problem;
 mod progress;
+mod scene_map;
 mod simulate;
 
 /// Turns 3D range data into maps a robot can plan on.

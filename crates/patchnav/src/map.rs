@@ -2,9 +2,15 @@
 //!
 //! `--backend`: `polygon`, `bbox6d`, `trimesh`, `rapier` (from a mesh or a patch map) or
 //! `pointcloud` (from a point cloud or a point-cloud map).
+//!
+//! `patchnav map build --scene lab --kind planes|hybrid|trimesh|pc --backend B --out MAP`
+//! builds the thesis's map types (§6.1, Table 6.1) from a synthetic scene instead
+//! ([`crate::scene_map`]: planes, hybrid and trimesh from the scene's exact geometry, pc from
+//! simulated ALRF scans), the maps `patchnav experiment lab-timing` and `lab-volume` plan on.
 
 use crate::input::InputArgs;
 use crate::progress::Progress;
+use crate::scene_map::{MapKind, ScanSetup, SceneSurfaces, Tessellation, scan_points};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use patch_core::{FromPatches, Patch, PatchMap, Point3};
@@ -51,7 +57,20 @@ pub enum BackendChoice {
 #[derive(Args, Debug)]
 pub struct BuildArgs {
     /// An OBJ mesh, a point cloud (.ply .pcd .xyz .bin .3d .png) or a map file (.pmap).
-    pub input: PathBuf,
+    #[arg(required_unless_present = "scene", conflicts_with = "scene")]
+    pub input: Option<PathBuf>,
+    /// Build from this synthetic scene (e.g. `lab`) instead of INPUT; needs --kind.
+    #[arg(long, requires = "kind")]
+    pub scene: Option<String>,
+    /// With --scene: the thesis's map type (pc needs --backend pointcloud).
+    #[arg(long, value_enum, requires = "scene")]
+    pub kind: Option<MapKind>,
+    /// With --scene: seed of the scene, the scan poses and the sensor noise.
+    #[arg(long, default_value_t = 0)]
+    pub scene_seed: u64,
+    /// With --scene --kind pc: number of simulated ALRF scans.
+    #[arg(long, default_value_t = 8)]
+    pub scans: usize,
     /// The backend of the new map.
     #[arg(long, value_enum)]
     pub backend: BackendChoice,
@@ -137,16 +156,57 @@ fn save<M: MapFile + MemoryUsage>(map: &M, out: &Path) -> Result<(u64, usize)> {
     Ok((bytes, map.memory_bytes()))
 }
 
+/// The patches or points of a map type of a synthetic scene.
+fn scene_source(
+    name: &str,
+    kind: MapKind,
+    args: &BuildArgs,
+    progress: &Progress,
+) -> Result<Source> {
+    if !scene_sim::scene_names().contains(&name) {
+        bail!("unknown scene `{name}`; choose one of: {}", scene_sim::scene_names().join(", "));
+    }
+    let scene = scene_sim::scene_by_name(name, args.scene_seed)
+        .with_context(|| format!("building scene `{name}`"))?;
+    let t = Tessellation::lab();
+    let surfaces = SceneSurfaces::of(&scene, &t)?;
+    Ok(match surfaces.patches(kind, &t)? {
+        Some(patches) => {
+            progress.say(format!("scene `{name}`, {kind} map: {} patches", patches.len()));
+            Source::Patches(patches)
+        }
+        None => {
+            let setup =
+                ScanSetup { scans: args.scans, height: 0.5, step_deg: None, seed: args.scene_seed };
+            let points: Vec<Point3> = scan_points(&scene, &setup)?.into_iter().flatten().collect();
+            progress.say(format!(
+                "scene `{name}`, pc map: {} ALRF scans, {} points",
+                args.scans,
+                points.len()
+            ));
+            Source::Points(points)
+        }
+    })
+}
+
 fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
-    let source = load_source(&args.input, &args.input_options, progress)?;
+    let (source, label) = match (&args.scene, args.kind, &args.input) {
+        (Some(name), Some(kind), _) => {
+            (scene_source(name, kind, args, progress)?, format!("scene `{name}`, {kind} map"))
+        }
+        (_, _, Some(input)) => {
+            (load_source(input, &args.input_options, progress)?, input.display().to_string())
+        }
+        // clap enforces one of the two.
+        _ => bail!("give an INPUT file, or --scene with --kind"),
+    };
     let spinner = progress.spinner("building");
     let patches = |what: &str| -> Result<Vec<Patch>> {
         match &source {
             Source::Patches(p) => Ok(p.clone()),
             Source::Points(_) => bail!(
-                "{}: a point cloud has no patches; the {what} backend needs a mesh or a patch map \
-                 (or use --backend pointcloud)",
-                args.input.display()
+                "{label}: a point cloud has no patches; the {what} backend needs a mesh or a patch map \
+                 (or use --backend pointcloud)"
             ),
         }
     };
@@ -167,8 +227,7 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
                 save(&PointCloudMap::from_points(&points)?, &args.out)?
             }
             (Source::Patches(_), None) => bail!(
-                "{}: the pointcloud backend needs a point cloud, or --spacing to sample the patches",
-                args.input.display()
+                "{label}: the pointcloud backend needs a point cloud, or --spacing to sample the patches"
             ),
         },
     };

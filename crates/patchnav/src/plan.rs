@@ -1,4 +1,4 @@
-//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
+//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|prm-star|lazy-prm|rrt-star|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
 //! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
 
@@ -8,9 +8,9 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
+    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, LazyPrm, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
     MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
-    RrtConnect, ShortcutConfig, shortcut_path,
+    RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -24,6 +24,11 @@ pub enum PlannerChoice {
     Prm,
     /// PRM* (Karaman and Frazzoli 2011): ⌈e(1 + 1/3) ln n⌉ nearest neighbours, cycles kept.
     PrmStar,
+    /// Lazy PRM (Bohlin and Kavraki 2000): six nearest neighbours, edges checked only when a
+    /// shortest path uses them.
+    LazyPrm,
+    /// RRT* (Karaman and Frazzoli 2011): ⌈2e ln n⌉ nearest candidates for parent and rewiring.
+    RrtStar,
     /// RRT-Connect (Kuffner and LaValle 2000), one goal.
     RrtConnect,
     /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
@@ -217,6 +222,11 @@ pub(crate) fn make_planner(
         PlannerChoice::PrmStar => {
             let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
             Box::new(Prm::new(map, space, config, seed))
+        }
+        PlannerChoice::LazyPrm => Box::new(LazyPrm::new(map, space, prm_config(), seed)),
+        PlannerChoice::RrtStar => {
+            let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
+            Box::new(RrtStar::new(map, space, config, seed))
         }
         PlannerChoice::RrtConnect => {
             if num_goals > 1 {

@@ -13,13 +13,16 @@ use crate::plan::{PlannerChoice, make_planner};
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use patch_core::{FromPatches, Point3, Real};
+use patch_core::{FromPatches, Patch, Point3, Real};
 use patch_map::{
     AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
     planar_patches_from_mesh, sample_patch_points,
 };
 use pointcloud::Aabb;
-use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, PlanningSpace, Problem};
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, PlanningSpace,
+    Problem,
+};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -69,17 +72,37 @@ pub struct ProblemArgs {
     pub sample_spacing: Option<Real>,
 }
 
-struct ProblemFile {
-    name: String,
-    mesh: PathBuf,
-    robot_radius: Real,
-    max_step: Real,
-    bounds: Aabb,
-    start: Point3,
-    goals: Vec<Point3>,
-    goal_tolerance: Real,
-    iterations: u64,
-    seeds: Vec<u64>,
+/// A planning problem read from its JSON file (the shared exchange format).
+pub(crate) struct ProblemFile {
+    pub(crate) name: String,
+    pub(crate) mesh: PathBuf,
+    pub(crate) robot_radius: Real,
+    pub(crate) max_step: Real,
+    pub(crate) bounds: Aabb,
+    pub(crate) start: Point3,
+    pub(crate) goals: Vec<Point3>,
+    pub(crate) goal_tolerance: Real,
+    pub(crate) iterations: u64,
+    pub(crate) seeds: Vec<u64>,
+}
+
+impl ProblemFile {
+    /// The planning space of the problem (its bounds, robot radius and step).
+    pub(crate) fn space(&self) -> Result<PlanningSpace> {
+        PlanningSpace::new(self.bounds, self.robot_radius, self.max_step)
+            .context("bounds, robot_radius, max_step")
+    }
+
+    /// The query from the start to `goals` (each a ball of the problem's tolerance).
+    pub(crate) fn query(&self, goals: &[Point3]) -> Problem {
+        Problem {
+            start: self.start,
+            goals: goals
+                .iter()
+                .map(|&center| Goal { center, tolerance: self.goal_tolerance })
+                .collect(),
+        }
+    }
 }
 
 fn point(v: &Value, what: &str) -> Result<Point3> {
@@ -101,7 +124,8 @@ fn number(v: &Value, key: &str) -> Result<Real> {
         .with_context(|| format!("`{key}` is missing or not a number"))
 }
 
-fn read_problem(path: &Path) -> Result<ProblemFile> {
+/// Reads a problem JSON; the mesh path is resolved relative to the file.
+pub(crate) fn read_problem(path: &Path) -> Result<ProblemFile> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let v: Value =
@@ -147,16 +171,27 @@ fn read_problem(path: &Path) -> Result<ProblemFile> {
     })
 }
 
-fn load_map(p: &ProblemFile, args: &ProblemArgs) -> Result<AnyMap> {
+/// The problem's mesh as planar patches (exact CAD faces).
+pub(crate) fn read_patches(p: &ProblemFile) -> Result<Vec<Patch>> {
     let mesh = pointcloud::io::read_mesh(&p.mesh)?;
-    let (patches, _) = planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
-    Ok(match args.backend {
+    Ok(planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad()).0)
+}
+
+/// The map of `backend` built from `patches`; a point-cloud map samples them every
+/// `sample_spacing` metres (default: a quarter of the robot radius).
+pub(crate) fn map_from_patches(
+    p: &ProblemFile,
+    patches: Vec<Patch>,
+    backend: ProblemBackend,
+    sample_spacing: Option<Real>,
+) -> Result<AnyMap> {
+    Ok(match backend {
         ProblemBackend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
         ProblemBackend::Bbox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
         ProblemBackend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
         ProblemBackend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
         ProblemBackend::Pointcloud => {
-            let spacing = args.sample_spacing.unwrap_or(p.robot_radius / 4.0);
+            let spacing = sample_spacing.unwrap_or(p.robot_radius / 4.0);
             AnyMap::PointCloud(PointCloudMap::from_points(&sample_patch_points(
                 &patches, spacing,
             )?)?)
@@ -164,94 +199,133 @@ fn load_map(p: &ProblemFile, args: &ProblemArgs) -> Result<AnyMap> {
     })
 }
 
+/// One timed `solve`: in `explore` mode exactly `iterations` iterations, otherwise until every
+/// goal of `problem` is reached or after `iterations`. Only the `solve` call is timed.
+pub(crate) fn solve_timed(
+    planner: &mut dyn Planner,
+    problem: &Problem,
+    mode: Mode,
+    iterations: u64,
+) -> (PlannerStatus, Real) {
+    let t = Instant::now();
+    let status = if mode == Mode::Explore {
+        planner.solve(problem, &mut MaxIterations(iterations))
+    } else {
+        planner.solve(problem, &mut AnyOf(GoalReached, MaxIterations(iterations)))
+    };
+    (status, t.elapsed().as_secs_f64())
+}
+
+/// The keys every result row starts with (the results format of `FORMAT.md`).
+fn row_head(p: &ProblemFile, planner: &str, backend: &str, mode: Mode, seed: u64) -> Value {
+    json!({
+        "kind": "planning",
+        "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
+        "planner": planner,
+        "backend": backend,
+        "problem": p.name,
+        "mode": mode_name(mode),
+        "seed": seed,
+    })
+}
+
+fn mode_name(mode: Mode) -> String {
+    format!("{mode:?}").to_lowercase()
+}
+
+/// The row of a run that could not be made (the planner cannot run on the map, or not on
+/// this query): recorded with the reason, as the results format asks.
+pub(crate) fn skipped_row(
+    p: &ProblemFile,
+    choice: PlannerChoice,
+    backend: &str,
+    mode: Mode,
+    seed: u64,
+    reason: &anyhow::Error,
+) -> Value {
+    let mut row = row_head(p, &format!("{choice:?}"), backend, mode, seed);
+    row["skipped"] = json!(format!("{reason:#}"));
+    row
+}
+
+/// The row of a finished run: `paths` holds the planner's path to each goal of the query.
+pub(crate) fn run_row(
+    p: &ProblemFile,
+    planner: &dyn Planner,
+    backend: &str,
+    mode: Mode,
+    seed: u64,
+    (status, time_s): (PlannerStatus, Real),
+    paths: &[Option<Vec<Point3>>],
+) -> Value {
+    let solved = mode != Mode::Explore && paths.iter().all(Option::is_some);
+    let path_length = solved
+        .then(|| paths.iter().flatten().map(|path| PathMetrics::of(path).length).sum::<Real>());
+    let c = planner.counters();
+    let mut row = row_head(p, planner.name(), backend, mode, seed);
+    for (key, value) in [
+        ("map", json!(p.mesh.file_name().map(|f| f.to_string_lossy().into_owned()))),
+        ("iterations", json!(c.samples)),
+        ("vertices", json!(planner.roadmap().node_count())),
+        ("time_s", json!(time_s)),
+        ("collision_checks", json!(c.collision_checks)),
+        ("solved", json!(solved)),
+        ("path_length", json!(path_length)),
+        ("status", json!(format!("{status:?}"))),
+        ("motion", json!("capsule")),
+    ] {
+        row[key] = value;
+    }
+    if mode == Mode::Roi {
+        row["goals"] = paths
+            .iter()
+            .map(|path| match path {
+                Some(path) => {
+                    json!({"solved": true, "path_length": PathMetrics::of(path).length})
+                }
+                None => json!({"solved": false, "path_length": null}),
+            })
+            .collect();
+    }
+    row
+}
+
 /// Runs every seed (and in `solve` mode every goal) of the problem; prints one JSON line each.
 pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Result<()> {
     let path = args.problem.as_ref().context("--problem is missing")?;
     let p = read_problem(path)?;
-    let map = load_map(&p, args)?;
-    let space = PlanningSpace::new(p.bounds, p.robot_radius, p.max_step)
-        .with_context(|| format!("{}: bounds, robot_radius, max_step", path.display()))?;
+    let map = map_from_patches(&p, read_patches(&p)?, args.backend, args.sample_spacing)?;
+    let space = p.space().with_context(|| path.display().to_string())?;
     let queries: Vec<(Option<usize>, Vec<Point3>)> = match args.mode {
         Mode::Explore => vec![(None, Vec::new())],
         Mode::Roi => vec![(None, p.goals.clone())],
         Mode::Solve => p.goals.iter().enumerate().map(|(i, g)| (Some(i), vec![*g])).collect(),
     };
-    let mode = format!("{:?}", args.mode).to_lowercase();
     let bar = progress.bar((p.seeds.len() * queries.len()) as u64, "runs");
     for &seed in &p.seeds {
         for (goal_index, goals) in &queries {
-            let problem = Problem {
-                start: p.start,
-                goals: goals
-                    .iter()
-                    .map(|&center| Goal { center, tolerance: p.goal_tolerance })
-                    .collect(),
-            };
-            let mut planner = match make_planner(choice, &map, space, seed, goals.len()) {
-                Ok(planner) => planner,
-                Err(reason) => {
-                    // A run that cannot be made is recorded, as the results format asks.
-                    let row = json!({
-                        "kind": "planning",
-                        "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
-                        "planner": format!("{choice:?}"),
-                        "backend": map.backend(),
-                        "problem": p.name,
-                        "mode": mode,
-                        "seed": seed,
-                        "skipped": format!("{reason:#}"),
-                    });
-                    bar.suspend(|| println!("{row}"));
-                    bar.inc(1);
-                    continue;
+            let problem = p.query(goals);
+            let row = match make_planner(choice, &map, space, seed, goals.len()) {
+                Ok(mut planner) => {
+                    let outcome = solve_timed(planner.as_mut(), &problem, args.mode, p.iterations);
+                    let paths: Vec<Option<Vec<Point3>>> =
+                        (0..goals.len()).map(|i| planner.path_to(i)).collect();
+                    let mut row = run_row(
+                        &p,
+                        planner.as_ref(),
+                        map.backend(),
+                        args.mode,
+                        seed,
+                        outcome,
+                        &paths,
+                    );
+                    if let Some(i) = goal_index {
+                        row["goal"] = json!(i);
+                    }
+                    row
                 }
+                Err(reason) => skipped_row(&p, choice, map.backend(), args.mode, seed, &reason),
             };
-            let t = Instant::now();
-            let status = if args.mode == Mode::Explore {
-                planner.solve(&problem, &mut MaxIterations(p.iterations))
-            } else {
-                planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(p.iterations)))
-            };
-            let time_s = t.elapsed().as_secs_f64();
-            let paths: Vec<Option<Vec<Point3>>> =
-                (0..goals.len()).map(|i| planner.path_to(i)).collect();
-            let solved = args.mode != Mode::Explore && paths.iter().all(Option::is_some);
-            let path_length = solved.then(|| {
-                paths.iter().flatten().map(|path| PathMetrics::of(path).length).sum::<Real>()
-            });
-            let c = planner.counters();
-            let mut row = json!({
-                "kind": "planning",
-                "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
-                "planner": planner.name(),
-                "backend": map.backend(),
-                "map": p.mesh.file_name().map(|f| f.to_string_lossy().into_owned()),
-                "problem": p.name,
-                "mode": mode,
-                "seed": seed,
-                "iterations": c.samples,
-                "vertices": planner.roadmap().node_count(),
-                "time_s": time_s,
-                "collision_checks": c.collision_checks,
-                "solved": solved,
-                "path_length": path_length,
-                "status": format!("{status:?}"),
-                "motion": "capsule",
-            });
-            if let Some(i) = goal_index {
-                row["goal"] = json!(i);
-            }
-            if args.mode == Mode::Roi {
-                row["goals"] = paths
-                    .iter()
-                    .map(|path| match path {
-                        Some(path) => {
-                            json!({"solved": true, "path_length": PathMetrics::of(path).length})
-                        }
-                        None => json!({"solved": false, "path_length": null}),
-                    })
-                    .collect();
-            }
             bar.suspend(|| println!("{row}"));
             bar.inc(1);
         }

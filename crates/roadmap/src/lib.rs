@@ -1,8 +1,9 @@
 //! Roadmap planners on patch maps: the RRT, the PRM, the Evasion RRT and the medial-axis
 //! planners of the thesis (Poppinga 2010, "Towards Autonomous Navigation for Robots with 3D
 //! Sensors", §5.5 and §6.1, Algorithms 13, 14, 11 and 12), RRT-Connect as a baseline from the
-//! literature, PRM* (Karaman & Frazzoli 2011) as an option of the PRM, the path metrics of the
-//! thesis's benchmark ([`metrics`]) and path shortcutting as a post-process ([`smoothing`]);
+//! literature, PRM* (Karaman & Frazzoli 2011) as an option of the PRM, RRT* (Karaman &
+//! Frazzoli 2011) and the lazy PRM (Bohlin & Kavraki 2000), the path metrics of the thesis's
+//! benchmark ([`metrics`]) and path shortcutting as a post-process ([`smoothing`]);
 //! generic over the collision capabilities of `patch-core` and never over a backend.
 //!
 //! # Planners and the capabilities they need (thesis Table 5.2)
@@ -12,6 +13,8 @@
 //! | RRT (Alg. 13) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Rrt`] |
 //! | PRM (Alg. 14) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] |
 //! | PRM* (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] with [`PrmConfig::star()`] |
+//! | lazy PRM (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`LazyPrm`] (any [`PrmConfig`]) |
+//! | RRT* (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtStar`] |
 //! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector<CapsuleStep>`] | [`EvasionRrt`] |
 //! | MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaPrm`] |
 //! | MA RRT (§5.5.2, no pseudo-code) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaRrt`] |
@@ -20,8 +23,8 @@
 //!
 //! A planner states its capability as a trait bound, so a map without it is rejected at
 //! compile time: the point-cloud map (`PointCloudMap` of `patch-map`), which answers no
-//! closest-patch queries, runs the RRT, PRM and RRT-Connect (and path shortcutting) but not
-//! the medial-axis planners (thesis Table 5.2).
+//! closest-patch queries, runs the RRT, PRM, RRT*, lazy PRM and RRT-Connect (and path
+//! shortcutting) but not the medial-axis planners (thesis Table 5.2).
 //!
 //! [`UnspecificStepIntersector<CapsuleStep>`]: patch_core::UnspecificStepIntersector
 //! [`SpecificStepIntersector<CapsuleStep>`]: patch_core::SpecificStepIntersector
@@ -35,10 +38,11 @@
 //!   [`GoalReached`], [`AnyOf`] (`PlannerTerminationCondition`).
 //! * [`Planner`]: the object-safe face, `solve` → [`PlannerStatus`] (an outcome, not an
 //!   error), the [`Roadmap`] (a petgraph graph, edge weight = length), paths and
-//!   [`PlannerCounters`] (samples, vertices, edges, collision checks and their time).
+//!   [`PlannerCounters`] (samples, vertices, edges, collision checks, closest-patch queries and
+//!   their times).
 //! * Each planner is generic over the capabilities it needs (table above); configs
-//!   ([`RrtConfig`], [`PrmConfig`], [`EvasionRrtConfig`], [`MaPrmConfig`], [`MaRrtConfig`],
-//!   and [`ShortcutConfig`] for the post-process) have no `Default` but named constructors
+//!   ([`RrtConfig`], [`PrmConfig`], [`RrtStarConfig`], [`EvasionRrtConfig`], [`MaPrmConfig`],
+//!   [`MaRrtConfig`], and [`ShortcutConfig`] for the post-process) have no `Default` but named constructors
 //!   with the thesis's choices, or documented ones where the thesis gives none.
 //!
 //! Runs are deterministic: a planner takes a seed (ChaCha8), every `solve` starts from it,
@@ -68,8 +72,9 @@
 //!   thesis gives neither the solver, its tolerance nor `N`; [`MaPrmConfig::for_space`] and
 //!   [`MaRrtConfig::for_space`] document this crate's values. The MA RRT has no pseudo-code
 //!   in the thesis; [`MaRrt`] retracts each sample, then takes one RRT step toward it (the
-//!   spec's recommendation, §4). Closest-patch queries are not counted in
-//!   [`PlannerCounters`].
+//!   spec's recommendation, §4). Their closest-patch queries are counted in
+//!   [`PlannerCounters::proximity_queries`] (and timed in [`PlannerCounters::proximity_time`]),
+//!   apart from the collision checks.
 //! * Path metrics (§5.5.4, Tables 5.5–5.11): the thesis does not define its quartile; see
 //!   [`metrics`] for the method used and the treatment of straight and repeated vertices.
 //! * PRM* (Karaman & Frazzoli 2011, k-nearest variant; [`PrmConfig::star`]): the PRM loop
@@ -77,12 +82,26 @@
 //!   ([`PrmConfig::neighbours_for`]) and without the component test, so its roadmap has
 //!   cycles; paths of every planner are shortest by length in the roadmap (Dijkstra), which
 //!   in the forests of the other planners is the unique path.
+//! * RRT* (Karaman & Frazzoli 2011, Algorithm 6, k-nearest variant; [`RrtStar`]): the RRT's
+//!   sampling and step, then choose-parent and rewiring among the `k(n) = ⌈2e·ln n⌉` nearest
+//!   vertices ([`RrtStarConfig::standard`], [`RrtStarConfig::neighbours_for`]; optionally
+//!   within [`RrtStarConfig::rewire_radius`]); a capsule is checked only if it would lower a
+//!   cost, and once per pair. Rewiring removes the old parent edge, so the roadmap stays a
+//!   tree, and recomputes the subtree's costs. A goal's path is the tree path to its cheapest
+//!   vertex within tolerance; it never grows during a run.
+//! * Lazy PRM (Bohlin & Kavraki 2000; [`LazyPrm`]): edges to the `N` (or PRM*'s `k(n)`)
+//!   nearest vertices without a check and without the component test; after each iteration a
+//!   query per unreached goal searches the shortest path over edges not known to collide,
+//!   checks its unknown edges from the start, deletes the first colliding one and repeats. A
+//!   goal is reached only through edges checked free; a union–find of the optimistic graph
+//!   (rebuilt after deletions) decides when a query is worth running. The roadmap holds only
+//!   the edges checked free.
 //! * Path shortcutting ([`smoothing`]): the thesis reports unsmoothed paths; [`shortcut_path`]
 //!   is a greedy pass plus random shortcuts ([`ShortcutConfig::standard`] documents this
 //!   crate's values). It never lengthens a path and adds only segments the map reported free.
 //!
 //! # Not yet here
-//! RRT*, lazy PRM, path smoothing other than shortcutting (e.g. splines), roadmap
+//! Path smoothing other than shortcutting (e.g. splines), roadmap
 //! metrics (only path metrics exist), the explored volume, the thesis's
 //! experiments, benchmarks, and a choice of nearest-neighbour structure per planner (all use
 //! [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL k-d tree for PRM, §6.1).
@@ -120,6 +139,7 @@ mod nn;
 mod planner;
 mod prm;
 mod rrt;
+mod rrt_star;
 pub mod smoothing;
 mod space;
 mod termination;
@@ -131,8 +151,9 @@ pub use medial::{MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, retract_to_medial_axis}
 pub use metrics::PathMetrics;
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
-pub use prm::{Prm, PrmConfig};
+pub use prm::{LazyPrm, Prm, PrmConfig};
 pub use rrt::{Rrt, RrtConfig, Sampler};
+pub use rrt_star::{RrtStar, RrtStarConfig};
 pub use smoothing::{ShortcutConfig, shortcut_path};
 pub use space::{Goal, PlanningSpace, Problem, SpaceError};
 pub use termination::{AnyOf, Deadline, GoalReached, MaxIterations, Progress, Termination};

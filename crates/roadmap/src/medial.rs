@@ -10,7 +10,12 @@
 //! (thesis Table 5.2): a map without closest-patch queries, such as the point-cloud map
 //! (`PointCloudMap` of the `patch-map` crate), cannot run them and is rejected at compile time.
 
-use patch_core::{Aabb, CapsuleStep, Point3, ProximityQuery, Real, UnspecificStepIntersector};
+use std::cell::Cell;
+use std::time::{Duration, Instant};
+
+use patch_core::{
+    Aabb, CapsuleStep, Point3, Proximity, ProximityQuery, Real, UnspecificStepIntersector,
+};
 use rand_chacha::ChaCha8Rng;
 
 use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
@@ -64,11 +69,22 @@ pub fn retract_to_medial_axis<M: ProximityQuery + ?Sized>(
     bounds: &Aabb,
     tolerance: Real,
 ) -> Option<Point3> {
+    retract(|q| map.closest_patch(q, Real::INFINITY), x, bounds, tolerance)
+}
+
+/// [`retract_to_medial_axis`] with the closest-patch query as a function (so the planners
+/// can count and time it).
+fn retract(
+    closest_patch: impl Fn(&Point3) -> Option<Proximity>,
+    x: &Point3,
+    bounds: &Aabb,
+    tolerance: Real,
+) -> Option<Point3> {
     let finite = x.iter().all(|c| c.is_finite());
     if !(tolerance.is_finite() && tolerance > 0.0 && finite && bounds.contains(x)) {
         return None;
     }
-    let closest = map.closest_patch(x, Real::INFINITY)?;
+    let closest = closest_patch(x)?;
     let dir = x - closest.point;
     let len = dir.norm();
     if !(closest.distance > 0.0 && len > 0.0 && len.is_finite()) {
@@ -86,9 +102,7 @@ pub fn retract_to_medial_axis<M: ProximityQuery + ?Sized>(
         return None;
     }
     let at = |s: Real| (x + dir * s).sup(&bounds.min).inf(&bounds.max);
-    let changed = |s: Real| {
-        map.closest_patch(&at(s), Real::INFINITY).is_some_and(|q| q.patch != closest.patch)
-    };
+    let changed = |s: Real| closest_patch(&at(s)).is_some_and(|q| q.patch != closest.patch);
     let mut lo: Real = 0.0;
     let mut hi = (tolerance / len).min(s_max);
     if hi <= 0.0 {
@@ -113,6 +127,38 @@ pub fn retract_to_medial_axis<M: ProximityQuery + ?Sized>(
         }
     }
     Some(at(0.5 * (lo + hi)))
+}
+
+/// Closest-patch queries through the map, counted and timed (for
+/// [`PlannerCounters::proximity_queries`]).
+struct ProximityCounter<'a, M: ?Sized> {
+    map: &'a M,
+    queries: Cell<u64>,
+    time: Cell<Duration>,
+}
+
+impl<'a, M: ProximityQuery + ?Sized> ProximityCounter<'a, M> {
+    fn new(map: &'a M) -> Self {
+        ProximityCounter { map, queries: Cell::new(0), time: Cell::new(Duration::ZERO) }
+    }
+
+    /// [`retract_to_medial_axis`], counting its closest-patch queries.
+    fn retract(&self, x: &Point3, bounds: &Aabb, tolerance: Real) -> Option<Point3> {
+        let closest_patch = |q: &Point3| {
+            let t0 = Instant::now();
+            let found = self.map.closest_patch(q, Real::INFINITY);
+            self.time.set(self.time.get() + t0.elapsed());
+            self.queries.set(self.queries.get() + 1);
+            found
+        };
+        retract(closest_patch, x, bounds, tolerance)
+    }
+
+    /// Writes the counts into the solution's counters.
+    fn finish(&self, solution: &mut Solution) {
+        solution.counters.proximity_queries = self.queries.get();
+        solution.counters.proximity_time = self.time.get();
+    }
 }
 
 /// The retraction tolerance of the `for_space` constructors: 1 % of the robot radius.
@@ -154,7 +200,8 @@ impl MaPrmConfig {
 /// centres are not retracted.
 ///
 /// With the same seed, the samples before retraction are those of the [`Prm`](crate::Prm).
-/// Closest-patch queries are not counted in [`PlannerCounters::collision_checks`].
+/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`] (not in
+/// [`PlannerCounters::collision_checks`]).
 ///
 /// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) is rejected at
@@ -221,11 +268,16 @@ impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planne
         let (map, space, config) = (self.map, &self.space, &self.config);
         let bounds = space.bounds();
         let tolerance = config.retraction_tolerance;
+        let counter = ProximityCounter::new(map);
         let sample = |rng: &mut ChaCha8Rng| {
-            retract_to_medial_axis(map, &planner::uniform(rng, space), &bounds, tolerance)
+            counter.retract(&planner::uniform(rng, space), &bounds, tolerance)
         };
         let solution = &mut self.solution;
-        solve_prm(map, space, &config.prm, self.seed, problem, stop, solution, sample)
+        let lazy = false;
+        let status =
+            solve_prm(map, space, &config.prm, lazy, self.seed, problem, stop, solution, sample);
+        counter.finish(solution);
+        status
     }
 
     fn roadmap(&self) -> &Roadmap {
@@ -277,7 +329,8 @@ impl MaRrtConfig {
 /// `x_new` is inside the bounds). Only `x′` lies on the medial axis; `x_new` does when the
 /// step reaches it. Goals are tested as in the RRT.
 ///
-/// Closest-patch queries are not counted in [`PlannerCounters::collision_checks`].
+/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`] (not in
+/// [`PlannerCounters::collision_checks`]).
 ///
 /// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) cannot run it.
@@ -315,12 +368,16 @@ impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planne
         let (map, space, config) = (self.map, &self.space, &self.config);
         let bounds = space.bounds();
         let tolerance = config.retraction_tolerance;
-        let retract = |x: Point3| retract_to_medial_axis(map, &x, &bounds, tolerance);
+        let counter = ProximityCounter::new(map);
+        let retract = |x: Point3| counter.retract(&x, &bounds, tolerance);
         let extend = |checker: &mut Checker<'_, M>, x_near: &Point3, x_new: &Point3| {
             (bounds.contains(x_new) && checker.free(x_near, x_new)).then_some(*x_new)
         };
         let solution = &mut self.solution;
-        solve_rrt(map, space, &config.rrt, self.seed, problem, stop, solution, retract, extend)
+        let status =
+            solve_rrt(map, space, &config.rrt, self.seed, problem, stop, solution, retract, extend);
+        counter.finish(solution);
+        status
     }
 
     fn roadmap(&self) -> &Roadmap {

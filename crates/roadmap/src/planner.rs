@@ -52,6 +52,14 @@ pub struct PlannerCounters {
     pub collision_checks: u64,
     /// Wall-clock time spent inside those checks.
     pub collision_time: Duration,
+    /// Closest-patch queries ([`ProximityQuery::closest_patch`]) asked of the map: those of the
+    /// medial-axis retraction of [`MaPrm`](crate::MaPrm) and [`MaRrt`](crate::MaRrt)
+    /// (thesis §5.5.2); 0 for the other planners.
+    ///
+    /// [`ProximityQuery::closest_patch`]: patch_core::ProximityQuery::closest_patch
+    pub proximity_queries: u64,
+    /// Wall-clock time spent inside those queries (not part of `collision_time`).
+    pub proximity_time: Duration,
 }
 
 /// A planner behind a trait object (generic inside, `dyn` at the boundary: a benchmark

@@ -1,10 +1,13 @@
 //! The probabilistic roadmap (Kavraki et al. 1996; thesis Algorithm 14, §5.5 and §6.1).
 
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
 use petgraph::graph::NodeIndex;
 use petgraph::unionfind::UnionFind;
+use petgraph::visit::Bfs;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -121,7 +124,104 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
         let space = &self.space;
         let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
         let solution = &mut self.solution;
-        solve_prm(self.map, space, &self.config, self.seed, problem, stop, solution, sample)
+        let lazy = false;
+        solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
+    }
+
+    fn roadmap(&self) -> &Roadmap {
+        &self.solution.graph
+    }
+
+    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
+        self.solution.path_to(goal)
+    }
+
+    fn counters(&self) -> PlannerCounters {
+        self.solution.counters
+    }
+
+    fn clear(&mut self) {
+        self.solution = Solution::default();
+    }
+}
+
+/// Lazy PRM (Bohlin & Kavraki 2000, "Path planning using lazy PRM"): the PRM's roadmap is
+/// built without collision checks, and only the edges of candidate paths are checked; not part
+/// of the thesis.
+///
+/// Each iteration draws a uniform sample, adds it, and joins it by *unchecked* edges to its
+/// `N` nearest existing vertices ([`PrmConfig::neighbours`]; with [`PrmConfig::star`] the
+/// `k(n)` of PRM*), within [`PrmConfig::connection_radius`]. There is no component test:
+/// unchecked edges are optimistic, and a forest of them would lose a connection for good when
+/// one of its edges turns out to collide (Bohlin & Kavraki likewise connect to all
+/// neighbours). Every edge is Unknown, Free or Colliding; a result, once checked, is kept.
+///
+/// # Queries and goal detection
+/// After each iteration, for every unreached goal, the query of Bohlin & Kavraki runs: the
+/// shortest path (Dijkstra by length) from the start to any vertex within the goal's tolerance
+/// over the edges not known to collide; its Unknown edges are checked in order from the start;
+/// the first colliding one is deleted and the search repeats, until a path whose edges are all
+/// Free is found (the goal is reached by its last vertex) or none is left.
+///
+/// Soundness: a goal counts as reached only through edges checked free. The union–find of the
+/// eager PRM is kept, but over the *optimistic* graph (all edges not known to collide) and only
+/// as a filter: the query runs only when it joins the start with a vertex near the goal. Since
+/// deleting an edge may split a component, which a union–find cannot undo, it is rebuilt from
+/// the remaining edges after a query that deleted edges. So after a failed query the filter is
+/// exact again, and the query is repeated only once new edges join the start's optimistic
+/// component to the goal again.
+///
+/// The direct goal step ([`PrmConfig::direct_goal_step`]) stays eager: its capsule is checked
+/// at once, as in the [`Prm`].
+///
+/// [`Planner::roadmap`] holds every vertex but only the edges checked free (the roadmap's
+/// contract: an edge is a motion found free), so [`PlannerCounters::edges`] counts those;
+/// [`Planner::path_to`] returns the shortest path over them.
+///
+/// Needs only [`UnspecificStepIntersector<CapsuleStep>`].
+///
+/// # Complexity
+/// Per iteration a [`KdNeighbors`] query; per query round a Dijkstra search over the
+/// optimistic graph (`O(E log V)`), at most one capsule check per Unknown edge of the path
+/// found, and a union–find rebuild (`O(E α(V))`) when an edge is deleted. Every edge is
+/// checked at most once.
+pub struct LazyPrm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+    map: &'m M,
+    space: PlanningSpace,
+    config: PrmConfig,
+    seed: u64,
+    solution: Solution,
+}
+
+impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> LazyPrm<'m, M> {
+    /// A planner on `map` in `space`; `seed` fixes the random stream (with the same seed the
+    /// samples are those of the [`Prm`]).
+    pub fn new(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> Self {
+        LazyPrm { map, space, config, seed, solution: Solution::default() }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PrmConfig {
+        &self.config
+    }
+
+    /// The space.
+    pub fn space(&self) -> &PlanningSpace {
+        &self.space
+    }
+}
+
+impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for LazyPrm<'_, M> {
+    fn name(&self) -> &'static str {
+        "lazy-prm"
+    }
+
+    fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
+        let space = &self.space;
+        let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
+        let solution = &mut self.solution;
+        let lazy = true;
+        solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
     }
 
     fn roadmap(&self) -> &Roadmap {
@@ -149,6 +249,9 @@ struct Forest {
     near_goal: Vec<Vec<NodeIndex>>,
     /// Per goal, whether its centre is a vertex.
     goal_vertex: Vec<bool>,
+    /// The unchecked edges of the lazy PRM (`None`: the eager PRM). With it, `components` is
+    /// the union–find of the optimistic graph.
+    lazy: Option<LazyEdges>,
 }
 
 impl Forest {
@@ -156,6 +259,9 @@ impl Forest {
         let v = solution.graph.add_node(p);
         self.nn.add(p);
         self.components.new_set();
+        if let Some(lazy) = &mut self.lazy {
+            lazy.adjacency.push(Vec::new());
+        }
         for (g, goal) in solution.goals.iter().enumerate() {
             if (goal.center - p).norm() <= goal.tolerance {
                 self.near_goal[g].push(v);
@@ -164,20 +270,154 @@ impl Forest {
         v
     }
 
+    /// Adds the edge `a`–`b`, found free, to the roadmap (and, lazily, as a Free edge).
     fn connect(&mut self, solution: &mut Solution, a: NodeIndex, b: NodeIndex) {
         let length = (solution.graph[a] - solution.graph[b]).norm();
         solution.graph.add_edge(a, b, length);
         self.components.union(a.index(), b.index());
+        if let Some(lazy) = &mut self.lazy {
+            lazy.push(a, b, length, EdgeState::Free);
+        }
+    }
+
+    /// Adds the unchecked edge `a`–`b` to the lazy graph.
+    fn connect_lazily(&mut self, solution: &Solution, a: NodeIndex, b: NodeIndex) {
+        let length = (solution.graph[a] - solution.graph[b]).norm();
+        let lazy = self.lazy.as_mut().expect("lazy mode");
+        lazy.push(a, b, length, EdgeState::Unknown);
+        self.components.union(a.index(), b.index());
     }
 }
 
-/// The PRM loop shared by [`Prm`] and the MA PRM: `sample(rng)` gives the next vertex, or
-/// `None` to drop the iteration's sample (it still counts as an iteration).
+/// What is known of a lazy edge.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum EdgeState {
+    Unknown,
+    Free,
+    Colliding,
+}
+
+/// An edge of the lazy PRM's optimistic graph.
+struct LazyEdge {
+    a: NodeIndex,
+    b: NodeIndex,
+    length: Real,
+    state: EdgeState,
+}
+
+/// The lazy PRM's graph: all edges with what is known of them.
+#[derive(Default)]
+struct LazyEdges {
+    edges: Vec<LazyEdge>,
+    /// Per vertex, the ids of its edges.
+    adjacency: Vec<Vec<usize>>,
+    /// Whether an edge was deleted since the union–find was built.
+    stale: bool,
+}
+
+impl LazyEdges {
+    fn push(&mut self, a: NodeIndex, b: NodeIndex, length: Real, state: EdgeState) {
+        let id = self.edges.len();
+        self.edges.push(LazyEdge { a, b, length, state });
+        self.adjacency[a.index()].push(id);
+        self.adjacency[b.index()].push(id);
+    }
+
+    /// The union–find of the edges not known to collide.
+    fn components(&self) -> UnionFind<usize> {
+        let mut uf = UnionFind::new(self.adjacency.len());
+        for e in self.edges.iter().filter(|e| e.state != EdgeState::Colliding) {
+            uf.union(e.a.index(), e.b.index());
+        }
+        uf
+    }
+
+    /// The edge ids of a shortest path (by length) from `from` to the first target reached,
+    /// over the edges not known to collide (Dijkstra; ties by vertex index), and that target.
+    fn shortest_path(
+        &self,
+        from: NodeIndex,
+        targets: &[NodeIndex],
+    ) -> Option<(Vec<usize>, NodeIndex)> {
+        let n = self.adjacency.len();
+        let mut is_target = vec![false; n];
+        for t in targets {
+            is_target[t.index()] = true;
+        }
+        let mut dist = vec![Real::INFINITY; n];
+        let mut via: Vec<Option<usize>> = vec![None; n];
+        let mut heap = BinaryHeap::new();
+        dist[from.index()] = 0.0;
+        heap.push(Queued { cost: 0.0, vertex: from.index() });
+        while let Some(Queued { cost, vertex }) = heap.pop() {
+            if cost > dist[vertex] {
+                continue;
+            }
+            if is_target[vertex] {
+                let mut path = Vec::new();
+                let mut v = vertex;
+                while let Some(id) = via[v] {
+                    path.push(id);
+                    let e = &self.edges[id];
+                    v = if e.a.index() == v { e.b.index() } else { e.a.index() };
+                }
+                path.reverse();
+                return Some((path, NodeIndex::new(vertex)));
+            }
+            for &id in &self.adjacency[vertex] {
+                let e = &self.edges[id];
+                if e.state == EdgeState::Colliding {
+                    continue;
+                }
+                let w = if e.a.index() == vertex { e.b.index() } else { e.a.index() };
+                let d = cost + e.length;
+                if d < dist[w] {
+                    dist[w] = d;
+                    via[w] = Some(id);
+                    heap.push(Queued { cost: d, vertex: w });
+                }
+            }
+        }
+        None
+    }
+}
+
+/// A vertex in Dijkstra's queue; the heap pops the lowest cost first (ties: lower index).
+#[derive(Copy, Clone, Debug)]
+struct Queued {
+    cost: Real,
+    vertex: usize,
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Queued {}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Queued {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.cost.total_cmp(&self.cost).then(other.vertex.cmp(&self.vertex))
+    }
+}
+
+/// The PRM loop shared by [`Prm`], [`LazyPrm`] (`lazy`) and the MA PRM: `sample(rng)` gives
+/// the next vertex, or `None` to drop the iteration's sample (it still counts as an
+/// iteration).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     config: &PrmConfig,
+    lazy: bool,
     seed: u64,
     problem: &Problem,
     stop: &mut dyn Termination,
@@ -198,6 +438,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
         components: UnionFind::new(0),
         near_goal: vec![Vec::new(); goals],
         goal_vertex: vec![false; goals],
+        lazy: lazy.then(LazyEdges::default),
     };
     let max_dist = match config.connection_radius {
         None => Real::INFINITY,
@@ -206,7 +447,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     };
     let start = forest.add(solution, problem.start);
     direct_goal_steps(solution, &mut forest, &mut checker, config, start);
-    update_reached(solution, &forest);
+    update_reached(solution, &mut forest, &mut checker);
     let mut iterations = 0u64;
     while !stop.should_stop(&solution.progress(iterations, started)) {
         iterations += 1;
@@ -218,16 +459,27 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
         let v = forest.add(solution, x);
         for n in near {
             let w = NodeIndex::new(n.index);
-            if (config.star || !forest.components.equiv(v.index(), w.index()))
+            if lazy {
+                forest.connect_lazily(solution, w, v);
+            } else if (config.star || !forest.components.equiv(v.index(), w.index()))
                 && checker.free(&solution.graph[w], &x)
             {
                 forest.connect(solution, w, v);
             }
         }
         direct_goal_steps(solution, &mut forest, &mut checker, config, v);
-        update_reached(solution, &forest);
+        update_reached(solution, &mut forest, &mut checker);
     }
     solution.finish(iterations, &checker);
+    if lazy {
+        // Connected to the start through edges checked free: the roadmap's own edges.
+        let mut connected = vec![false; solution.graph.node_count()];
+        let mut bfs = Bfs::new(&solution.graph, start);
+        while let Some(v) = bfs.next(&solution.graph) {
+            connected[v.index()] = true;
+        }
+        return solution.status(|v| connected[v.index()]);
+    }
     let start_root = forest.components.find(start.index());
     solution.status(|v| forest.components.find(v.index()) == start_root)
 }
@@ -257,12 +509,64 @@ fn direct_goal_steps<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     }
 }
 
-/// Marks goals whose nearby vertices joined the start's component.
-fn update_reached(solution: &mut Solution, forest: &Forest) {
+/// Marks goals whose nearby vertices joined the start's component (lazily: for which a query
+/// finds a path of edges checked free).
+fn update_reached<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+    solution: &mut Solution,
+    forest: &mut Forest,
+    checker: &mut Checker<'_, M>,
+) {
     for g in 0..solution.goals.len() {
-        if solution.reached[g].is_none() {
+        if solution.reached[g].is_some() {
+            continue;
+        }
+        if forest.lazy.is_some() {
+            solution.reached[g] = lazy_query(solution, forest, checker, g);
+        } else {
             solution.reached[g] =
                 forest.near_goal[g].iter().copied().find(|w| forest.components.equiv(0, w.index()));
+        }
+    }
+}
+
+/// The query of the lazy PRM for goal `g` (see [`LazyPrm`]): the vertex near the goal at the
+/// end of a path from the start whose edges are all checked free, or `None`.
+fn lazy_query<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+    solution: &mut Solution,
+    forest: &mut Forest,
+    checker: &mut Checker<'_, M>,
+    g: usize,
+) -> Option<NodeIndex> {
+    let start = NodeIndex::new(0);
+    loop {
+        let lazy = forest.lazy.as_mut().expect("lazy mode");
+        if lazy.stale {
+            forest.components = lazy.components();
+            lazy.stale = false;
+        }
+        if !forest.near_goal[g].iter().any(|w| forest.components.equiv(0, w.index())) {
+            return None;
+        }
+        let (path, target) = lazy.shortest_path(start, &forest.near_goal[g])?;
+        let mut all_free = true;
+        for id in path {
+            let edge = &mut lazy.edges[id];
+            if edge.state != EdgeState::Unknown {
+                continue;
+            }
+            let (a, b) = (edge.a, edge.b);
+            if checker.free(&solution.graph[a], &solution.graph[b]) {
+                edge.state = EdgeState::Free;
+                solution.graph.add_edge(a, b, edge.length);
+            } else {
+                edge.state = EdgeState::Colliding;
+                lazy.stale = true;
+                all_free = false;
+                break;
+            }
+        }
+        if all_free {
+            return Some(target);
         }
     }
 }

@@ -229,8 +229,9 @@ fn test_goals<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     }
 }
 
-/// The next sample, and whether it is a goal centre chosen by the goal bias.
-fn sample(
+/// The next sample, and whether it is a goal centre chosen by the goal bias (shared with the
+/// RRT*).
+pub(crate) fn sample(
     rng: &mut ChaCha8Rng,
     space: &PlanningSpace,
     config: &RrtConfig,

@@ -194,6 +194,37 @@ fn ma_prm_vertices_have_more_clearance_than_prm_vertices() {
 }
 
 #[test]
+fn closest_patch_queries_are_counted() {
+    let counted = Counted::new(corridor());
+    let s = space(corridor_box());
+    let problem = along_the_corridor();
+    let planners: Vec<Box<dyn Planner + '_>> = vec![
+        Box::new(MaPrm::new(&counted, s, MaPrmConfig::for_space(&s), 5)),
+        Box::new(MaRrt::new(&counted, s, MaRrtConfig::for_space(&s), 5)),
+    ];
+    for mut p in planners {
+        counted.reset_counts();
+        p.solve(&problem, &mut MaxIterations(200));
+        let (c, seen) = (p.counters(), counted.counts());
+        assert_eq!(c.proximity_queries, seen.closest_patch, "{}", p.name());
+        assert_eq!(c.collision_checks, seen.is_step_free, "{}", p.name());
+        // Each kept sample needs at least the first query, one probe and the bisection.
+        assert!(c.proximity_queries >= 3 * (c.vertices as u64 - 1), "{}", p.name());
+        assert!(c.proximity_time > std::time::Duration::ZERO);
+        // A second solve starts the count again.
+        counted.reset_counts();
+        p.solve(&problem, &mut MaxIterations(50));
+        assert_eq!(p.counters().proximity_queries, counted.counts().closest_patch);
+        p.clear();
+        assert_eq!(p.counters().proximity_queries, 0);
+    }
+    // The plain PRM asks none.
+    let mut prm = Prm::new(&counted, s, PrmConfig::thesis(), 5);
+    prm.solve(&problem, &mut MaxIterations(50));
+    assert_eq!(prm.counters().proximity_queries, 0);
+}
+
+#[test]
 fn invalid_starts_and_goals() {
     let map = corridor();
     let s = space(corridor_box());

@@ -17,7 +17,8 @@ mod office;
 #[derive(Subcommand, Debug)]
 pub enum ExperimentCommand {
     /// Thesis §5.5.3: every planner on every backend, reach four regions of interest from the
-    /// centre of the office floor plan; prints Tables 5.3–5.11 beside the thesis's numbers.
+    /// centre of the office floor plan (`--seeds` runs each, capped at `--max-iterations`);
+    /// prints Tables 5.3–5.11 beside the thesis's numbers and checks the thesis's claims.
     Office(office::OfficeArgs),
     /// Thesis Fig 6.4: RRT time against iterations on the lab's four map types (CSV and SVG).
     LabTiming(lab::LabTimingArgs),

@@ -1,14 +1,1169 @@
-//! Thesis §5.5.3 (Tables 5.3–5.11).
+//! `patchnav experiment office`: the thesis's preliminary experiment (§5.5.3–5.5.4, Tables
+//! 5.3–5.11; spec §5.1) on the office floor plan of the shared benchmark.
+//!
+//! Every planner of [`PLANNERS`] runs on every backend of [`BACKENDS`] it can run on, once per
+//! seed `0..N`. A run reaches all four regions of interest (ROIs) from the central start with
+//! one growing tree or roadmap and stops there, or after the iteration cap (the `roi` mode of
+//! `patchnav plan --problem`, whose problem reading, map building, planner construction and
+//! result rows it shares). Each map is built once per backend; only `solve` is timed.
+//!
+//! # Metrics of a run (successful runs only, as the thesis: L6119–6121)
+//! The thesis measures "the paths from starting point to ROIs" (Tables 5.5–5.11), so every
+//! metric of a run is taken over its four paths, start → ROI *i*, each a path in the one tree
+//! or roadmap of the run (a shared prefix is counted once per path, as in the thesis's "added
+//! length"):
+//! * **time**: the wall time of `solve`, seconds;
+//! * **added length**: the sum of the four path lengths ([`roadmap::metrics::added_length`]);
+//! * **steep / total turns**: the sums over the four paths of [`roadmap::PathMetrics`]'s
+//!   `steep_turns` (> 90°) and `turns`. The thesis's RRT median of 20 turns on 23 m of
+//!   added length fits a sum over the four paths (about one turn per metre of path); as a
+//!   per-path count it would need segments of about 0.3 m;
+//! * **curviness**: the upper quartile of the turn angles at the interior vertices of all four
+//!   paths pooled ([`roadmap::metrics::turn_angles`], then
+//!   [`roadmap::metrics::upper_quartile`]; straight vertices count with angle 0, as in the
+//!   metrics module), in degrees: the thesis's "upper quartile of the angle of all turns on
+//!   paths to the ROIs" (L6364–6366).
+//!
+//! # Statistics
+//! Medians and quartiles over the successful runs of a cell by linear interpolation between
+//! closest ranks (Hyndman & Fan type 7, the method of `roadmap::metrics::upper_quartile`;
+//! written here as [`quantile`] because roadmap exports only the upper quartile). Quartiles
+//! are printed as ratios to the median (Tables 5.4, 5.6, 5.11). In Tables 5.7–5.9 the ratio is
+//! the quantile of steep turns over the quantile of total turns, as the thesis's numbers show
+//! (3/20 = .150, 22/91 = .242); 0 where there are no turns at all.
+//!
+//! # Caps
+//! The thesis found the MA PRM's number of vertices by binary search (L6123–6141); here every
+//! planner gets the same iteration cap (`--max-iterations`, 100,000 by default) and a run that
+//! has not reached all four ROIs by then counts as a failure, reported as `n/N`.
 
+use crate::plan::{PlannerChoice, make_planner};
+use crate::problem::{
+    Mode, ProblemBackend, map_from_patches, read_patches, read_problem, run_row, skipped_row,
+    solve_timed,
+};
 use crate::progress::Progress;
-use anyhow::{Result, bail};
+use PlannerChoice as P;
+use ProblemBackend as B;
+use anyhow::{Context, Result, bail};
 use clap::Args;
+use patch_core::{Point3, Real};
+use roadmap::metrics::{added_length, turn_angles, upper_quartile};
+use roadmap::{PathMetrics, Planner};
+use serde_json::json;
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
 
 /// Arguments of `patchnav experiment office`.
 #[derive(Args, Debug)]
-pub struct OfficeArgs {}
+pub struct OfficeArgs {
+    /// The planning problem JSON (mesh, robot_radius, max_step, bounds, start, four goals,
+    /// goal_tolerance; its `iterations` and `seeds` are ignored), relative to the current
+    /// directory.
+    #[arg(long, default_value = "../shared/bench/floorplan.json")]
+    pub problem: PathBuf,
+    /// Runs per planner and backend, with seeds 0..N.
+    #[arg(long, default_value_t = 50)]
+    pub seeds: u64,
+    /// Iteration cap of a run; a run that has not reached every ROI by then fails.
+    #[arg(long = "max-iterations", default_value_t = 100_000)]
+    pub max_iterations: u64,
+    /// Only these planners (comma-separated; default: all, in the thesis's order).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub planners: Vec<PlannerChoice>,
+    /// Only these backends (comma-separated; default: all, in the thesis's column order).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub backends: Vec<ProblemBackend>,
+    /// Also write one JSON line per run (the rows of `plan --problem` plus the metrics).
+    #[arg(long)]
+    pub jsonl: Option<PathBuf>,
+    /// Point spacing of the `pointcloud` backend, metres (default: a quarter of the robot
+    /// radius).
+    #[arg(long = "sample-spacing")]
+    pub sample_spacing: Option<Real>,
+}
 
-/// Runs the experiment.
-pub fn run(_args: &OfficeArgs, _progress: &Progress) -> Result<()> {
-    bail!("not built yet")
+/// A row of the tables: a planner and its label.
+struct PlannerRow {
+    choice: PlannerChoice,
+    label: &'static str,
+}
+
+/// The rows of the tables: the thesis's five in its order (Table 5.3), then ours. Adding a
+/// planner is one line here (a planner that cannot plan to four goals is reported as skipped).
+const PLANNERS: &[PlannerRow] = &[
+    PlannerRow { choice: PlannerChoice::Rrt, label: "RRT" },
+    PlannerRow { choice: PlannerChoice::MaRrt, label: "MA RRT" },
+    PlannerRow { choice: PlannerChoice::EvasionRrt, label: "Ev. RRT" },
+    PlannerRow { choice: PlannerChoice::Prm, label: "PRM" },
+    PlannerRow { choice: PlannerChoice::MaPrm, label: "MA PRM" },
+    PlannerRow { choice: PlannerChoice::RrtConnect, label: "RRT-Connect" },
+    PlannerRow { choice: PlannerChoice::PrmStar, label: "PRM*" },
+    PlannerRow { choice: PlannerChoice::LazyPrm, label: "lazy PRM" },
+    PlannerRow { choice: PlannerChoice::RrtStar, label: "RRT*" },
+];
+
+/// The columns: ours in the thesis's order Simple | BB6D | OPCODE | Bullet, then the
+/// point-cloud map (Algorithm 10), which the thesis's table does not have.
+const BACKENDS: &[(ProblemBackend, &str, &str)] = &[
+    (ProblemBackend::Polygon, "polygon", "Simple"),
+    (ProblemBackend::Bbox6d, "bbox6d", "BB6D"),
+    (ProblemBackend::Trimesh, "trimesh", "OPCODE"),
+    (ProblemBackend::Rapier, "rapier", "Bullet"),
+    (ProblemBackend::Pointcloud, "pointcloud", "–"),
+];
+
+/// The thesis's planners (the row labels of its tables).
+const THESIS_PLANNERS: [&str; 5] = ["RRT", "MA RRT", "Ev. RRT", "PRM", "MA PRM"];
+/// The thesis's columns.
+const THESIS_BACKENDS: [&str; 4] = ["Simple", "BB6D", "OPCODE", "Bullet"];
+
+type ThesisTable = &'static [(&'static str, [&'static str; 4])];
+
+/// Thesis Table 5.3, median wall time in s (L6154–6166).
+const THESIS_5_3: ThesisTable = &[
+    ("RRT", [".010057", ".006137", ".002435", ".004721"]),
+    ("MA RRT", [".124055", ".060409", "–", ".055298"]),
+    ("Ev. RRT", [".18627", ".156209", "–", ".099351"]),
+    ("PRM", [".013578", ".010544", ".001309", ".008801"]),
+    ("MA PRM", ["1.96683", "1.20087", "–", ".678831"]),
+];
+/// Thesis Table 5.4, time quartiles / median (L6168–6180).
+const THESIS_5_4: ThesisTable = &[
+    ("RRT", [".547/1.874", ".570/1.837", ".716/1.544", ".570/1.730"]),
+    ("MA RRT", [".513/1.484", ".550/1.643", "–", ".520/1.545"]),
+    ("Ev. RRT", [".339/2.141", ".305/1.909", "–", ".337/2.124"]),
+    ("PRM", [".525/2.621", ".520/2.830", ".770/1.388", ".452/3.123"]),
+    ("MA PRM", [".253/1.307", ".239/1.243", "–", ".354/1.558"]),
+];
+/// Thesis Table 5.5, median added path length in m (L6220–6232).
+const THESIS_5_5: ThesisTable = &[
+    ("RRT", ["23.1608", "23.1608", "21.5803", "23.1608"]),
+    ("MA RRT", ["22.166", "22.3942", "–", "22.1411"]),
+    ("Ev. RRT", ["25.7439", "26.621", "–", "26.621"]),
+    ("PRM", ["41.3277", "41.3277", "40.2935", "41.3277"]),
+    ("MA PRM", ["66.0655", "64.6227", "–", "68.2961"]),
+];
+/// Thesis Table 5.6, added-length quartiles / median (L6239–6253).
+const THESIS_5_6: ThesisTable = &[
+    ("RRT", [".904/1.060", ".904/1.060", ".926/1.158", ".904/1.060"]),
+    ("MA RRT", [".947/1.042", ".935/1.034", "–", ".943/1.047"]),
+    ("Ev. RRT", [".923/1.104", ".932/1.066", "–", ".924/1.066"]),
+    ("PRM", [".838/1.212", ".838/1.212", ".843/1.291", ".838/1.212"]),
+    ("MA PRM", [".797/1.094", ".815/1.167", "–", ".771/1.158"]),
+];
+/// Thesis Tables 5.7 (median), 5.8 (lower quartile), 5.9 (upper quartile): steep turns /
+/// total turns / ratio (L6255–6342).
+const THESIS_5_7_TO_9: ThesisTable = &[
+    ("RRT, median", ["3/20/.150", "3/20/.150", "2/18/.111", "3/20/.150"]),
+    ("RRT, lower", ["2/17/.118", "2/17/.118", "1/16/.062", "2/17/.118"]),
+    ("RRT, upper", ["4/22/.182", "4/22/.182", "3/21/.143", "4/22/.182"]),
+    ("MA RRT, median", ["3/18/.167", "3/18/.167", "–", "2/18/.111"]),
+    ("MA RRT, lower", ["2/17/.118", "1/17/.059", "–", "2/17/.118"]),
+    ("MA RRT, upper", ["4/20/.200", "4/20/.200", "–", "4/20/.200"]),
+    ("Ev. RRT, median", ["3/23/.130", "3/24/.125", "–", "3/24/.125"]),
+    ("Ev. RRT, lower", ["2/21/.095", "2/22/.091", "–", "2/22/.091"]),
+    ("Ev. RRT, upper", ["5/25/.200", "5/25/.200", "–", "5/25/.200"]),
+    ("PRM, median", ["7/14/.500", "7/14/.500", "4/8/.500", "7/14/.500"]),
+    ("PRM, lower", ["4/9/.444", "4/9/.444", "3/5/.600", "4/9/.444"]),
+    ("PRM, upper", ["9/18/.500", "9/18/.500", "7/11/.636", "9/18/.500"]),
+    ("MA PRM, median", ["36/160/.225", "36/167/.216", "–", "38/189/.201"]),
+    ("MA PRM, lower", ["22/91/.242", "22/95/.232", "–", "24/95/.253"]),
+    ("MA PRM, upper", ["46/242/.190", "48/242/.198", "–", "52/238/.218"]),
+];
+/// Thesis Table 5.10, median curviness [°] (L6344–6358).
+const THESIS_5_10: ThesisTable = &[
+    ("RRT", ["78.0185", "78.0185", "71.383", "78.0185"]),
+    ("MA RRT", ["78.5776", "77.6607", "–", "78.8892"]),
+    ("Ev. RRT", ["80.0567", "78.5778", "–", "77.8766"]),
+    ("PRM", ["119.903", "119.903", "135.332", "119.903"]),
+    ("MA PRM", ["86.8547", "86.8317", "–", "86.5707"]),
+];
+/// Thesis Table 5.11, curviness quartiles / median (L6386–6400).
+const THESIS_5_11: ThesisTable = &[
+    ("RRT", [".850/1.093", ".850/1.093", ".858/1.153", ".850/1.093"]),
+    ("MA RRT", [".791/1.048", ".838/1.060", "–", ".832/1.065"]),
+    ("Ev. RRT", [".913/1.042", ".937/1.060", "–", ".946/1.063"]),
+    ("PRM", [".876/1.080", ".876/1.080", ".905/1.158", ".876/1.080"]),
+    ("MA PRM", [".973/1.028", ".968/1.029", "–", ".960/1.042"]),
+];
+
+/// The metrics of one successful run (see the [module docs](self)).
+#[derive(Copy, Clone, Debug)]
+struct RunMetrics {
+    time_s: Real,
+    length: Real,
+    steep: Real,
+    turns: Real,
+    curviness_deg: Real,
+}
+
+impl RunMetrics {
+    fn of(time_s: Real, paths: &[Vec<Point3>]) -> RunMetrics {
+        let per_path: Vec<PathMetrics> = paths.iter().map(|p| PathMetrics::of(p)).collect();
+        let angles: Vec<Real> = paths.iter().flat_map(|p| turn_angles(p)).collect();
+        RunMetrics {
+            time_s,
+            length: added_length(paths.iter().map(Vec::as_slice)),
+            steep: per_path.iter().map(|m| m.steep_turns as Real).sum(),
+            turns: per_path.iter().map(|m| m.turns as Real).sum(),
+            curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
+        }
+    }
+}
+
+/// The outcome of one planner on one backend.
+enum Cell {
+    /// The planner cannot run on this map (or on this problem): the reason.
+    Cannot(String),
+    /// The runs: per seed, the metrics if the run reached every ROI.
+    Ran(Vec<Option<RunMetrics>>),
+}
+
+impl Cell {
+    fn successes(&self) -> Vec<RunMetrics> {
+        match self {
+            Cell::Cannot(_) => Vec::new(),
+            Cell::Ran(runs) => runs.iter().flatten().copied().collect(),
+        }
+    }
+}
+
+/// The results: `cells[planner][backend]` over the selected planners and backends.
+struct Results<'a> {
+    planners: Vec<&'a PlannerRow>,
+    backends: Vec<&'a (ProblemBackend, &'static str, &'static str)>,
+    cells: Vec<Vec<Cell>>,
+}
+
+/// The `p`-quantile (`0 ≤ p ≤ 1`) of `values` by linear interpolation between closest ranks
+/// (Hyndman & Fan type 7, the method of `roadmap::metrics::upper_quartile`): over the sorted
+/// values, `h = p (n − 1)`, `x_⌊h⌋ + (h − ⌊h⌋)(x_⌊h⌋+1 − x_⌊h⌋)`. `None` for no values.
+fn quantile(values: &[Real], p: Real) -> Option<Real> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut sorted = values.to_vec();
+    sorted.sort_by(Real::total_cmp);
+    let h = p * (sorted.len() - 1) as Real;
+    let lo = h.floor() as usize;
+    let hi = (lo + 1).min(sorted.len() - 1);
+    Some(sorted[lo] + (h - lo as Real) * (sorted[hi] - sorted[lo]))
+}
+
+/// Lower quartile, median, upper quartile.
+fn quartiles(values: &[Real]) -> Option<[Real; 3]> {
+    Some([quantile(values, 0.25)?, quantile(values, 0.5)?, quantile(values, 0.75)?])
+}
+
+/// A number as the thesis prints it: six significant digits, no trailing zeros, no leading
+/// zero before the decimal point (".010057", "23.1608").
+fn thesis_number(x: Real) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (5 - x.abs().log10().floor() as i64).max(0) as usize;
+    let mut s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s = s.trim_end_matches('0').trim_end_matches('.').to_owned();
+    }
+    strip_leading_zero(s)
+}
+
+/// A ratio with three decimals and no leading zero (".547").
+fn ratio(x: Real) -> String {
+    strip_leading_zero(format!("{x:.3}"))
+}
+
+fn strip_leading_zero(s: String) -> String {
+    match s.strip_prefix("0.") {
+        Some(rest) => format!(".{rest}"),
+        None => s,
+    }
+}
+
+/// A turn count: whole numbers as such, interpolated quantiles with up to two decimals (the
+/// quartiles of whole numbers fall on quarters).
+fn count(x: Real) -> String {
+    let s = format!("{x:.2}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// "lower/upper" as ratios to the median (Tables 5.4, 5.6, 5.11).
+fn quartile_ratios(values: &[Real]) -> Option<String> {
+    let [lo, med, up] = quartiles(values)?;
+    Some(format!("{}/{}", ratio(lo / med), ratio(up / med)))
+}
+
+/// Steep turns over total turns; 0 for no turns (no turn is steep).
+fn steep_ratio(steep: Real, turns: Real) -> Real {
+    if turns > 0.0 { steep / turns } else { 0.0 }
+}
+
+/// "steep/total/ratio" at quantile `p` (Tables 5.7–5.9).
+fn turns_at(runs: &[RunMetrics], p: Real) -> Option<String> {
+    let steep = quantile(&runs.iter().map(|r| r.steep).collect::<Vec<_>>(), p)?;
+    let turns = quantile(&runs.iter().map(|r| r.turns).collect::<Vec<_>>(), p)?;
+    Some(format!("{}/{}/{}", count(steep), count(turns), ratio(steep_ratio(steep, turns))))
+}
+
+fn metric(runs: &[RunMetrics], f: fn(&RunMetrics) -> Real) -> Vec<Real> {
+    runs.iter().map(f).collect()
+}
+
+/// A row variant of a table: its label suffix and how a cell is printed from the successful
+/// runs (`None`: no successful run).
+type CellFormat = fn(&[RunMetrics]) -> Option<String>;
+
+/// One printed table: ours, then the thesis's.
+struct TableSpec {
+    id: &'static str,
+    caption: &'static str,
+    rows: &'static [(&'static str, CellFormat)],
+    thesis: ThesisTable,
+}
+
+const TABLES: &[TableSpec] = &[
+    TableSpec {
+        id: "5.3",
+        caption: "median wall time [s] to reach the ROIs",
+        rows: &[("", |r| quantile(&metric(r, |m| m.time_s), 0.5).map(thesis_number))],
+        thesis: THESIS_5_3,
+    },
+    TableSpec {
+        id: "5.4",
+        caption: "lower/upper quartile of wall time, as factors of the median",
+        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.time_s)))],
+        thesis: THESIS_5_4,
+    },
+    TableSpec {
+        id: "5.5",
+        caption: "median added length [m] of the paths from the start to all ROIs",
+        rows: &[("", |r| quantile(&metric(r, |m| m.length), 0.5).map(thesis_number))],
+        thesis: THESIS_5_5,
+    },
+    TableSpec {
+        id: "5.6",
+        caption: "lower/upper quartile of added length, as factors of the median",
+        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.length)))],
+        thesis: THESIS_5_6,
+    },
+    TableSpec {
+        id: "5.7–5.9",
+        caption: "steep (> 90°) / total turns / ratio on the paths to the ROIs: median, lower \
+                  and upper quartile",
+        rows: &[
+            (", median", |r| turns_at(r, 0.5)),
+            (", lower", |r| turns_at(r, 0.25)),
+            (", upper", |r| turns_at(r, 0.75)),
+        ],
+        thesis: THESIS_5_7_TO_9,
+    },
+    TableSpec {
+        id: "5.10",
+        caption: "median curviness [°] (upper quartile of the turn angles on the paths to the \
+                  ROIs)",
+        rows: &[("", |r| quantile(&metric(r, |m| m.curviness_deg), 0.5).map(thesis_number))],
+        thesis: THESIS_5_10,
+    },
+    TableSpec {
+        id: "5.11",
+        caption: "lower/upper quartile of curviness, as factors of the median",
+        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.curviness_deg)))],
+        thesis: THESIS_5_11,
+    },
+];
+
+/// Lays out rows of cells in columns: the first left-aligned, the others right-aligned.
+fn layout(rows: &[Vec<String>]) -> String {
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(0);
+    let width = |c: usize| rows.iter().filter_map(|r| r.get(c)).map(|s| s.chars().count()).max();
+    let widths: Vec<usize> = (0..columns).map(|c| width(c).unwrap_or(0)).collect();
+    let mut out = String::new();
+    for row in rows {
+        let mut line = String::new();
+        for (c, cell) in row.iter().enumerate() {
+            let pad = widths[c] - cell.chars().count();
+            if c == 0 {
+                line.push_str(cell);
+                line.push_str(&" ".repeat(pad));
+            } else {
+                line.push_str("  ");
+                line.push_str(&" ".repeat(pad));
+                line.push_str(cell);
+            }
+        }
+        out.push_str(line.trim_end());
+        out.push('\n');
+    }
+    out
+}
+
+impl Results<'_> {
+    fn cell(&self, planner: PlannerChoice, backend: ProblemBackend) -> Option<&Cell> {
+        let i = self.planners.iter().position(|p| p.choice == planner)?;
+        let j = self.backends.iter().position(|b| b.0 == backend)?;
+        Some(&self.cells[i][j])
+    }
+
+    /// The median of `f` over the successful runs of a cell.
+    fn median(
+        &self,
+        planner: PlannerChoice,
+        backend: ProblemBackend,
+        f: fn(&RunMetrics) -> Real,
+    ) -> Option<Real> {
+        quantile(&metric(&self.cell(planner, backend)?.successes(), f), 0.5)
+    }
+
+    fn quartiles(
+        &self,
+        planner: PlannerChoice,
+        backend: ProblemBackend,
+        f: fn(&RunMetrics) -> Real,
+    ) -> Option<[Real; 3]> {
+        quartiles(&metric(&self.cell(planner, backend)?.successes(), f))
+    }
+
+    /// The planners that ran at least once, with a note for those that could run nowhere.
+    fn skipped_planners(&self) -> Vec<String> {
+        self.planners
+            .iter()
+            .zip(&self.cells)
+            .filter_map(|(p, cells)| match cells.first() {
+                Some(Cell::Cannot(reason))
+                    if cells.iter().all(|c| matches!(c, Cell::Cannot(_))) =>
+                {
+                    Some(format!("{}: skipped on every backend ({reason})", p.label))
+                }
+                _ => None,
+            })
+            .collect()
+    }
+
+    fn shown_planners(&self) -> Vec<usize> {
+        (0..self.planners.len())
+            .filter(|&i| self.cells[i].iter().any(|c| matches!(c, Cell::Ran(_))))
+            .collect()
+    }
+
+    fn successes_line(&self) -> String {
+        let parts: Vec<String> = self
+            .shown_planners()
+            .into_iter()
+            .map(|i| {
+                let counts: Vec<String> = self.cells[i]
+                    .iter()
+                    .map(|c| match c {
+                        Cell::Cannot(_) => "–".to_owned(),
+                        Cell::Ran(runs) => {
+                            format!("{}/{}", runs.iter().flatten().count(), runs.len())
+                        }
+                    })
+                    .collect();
+                format!("{} {}", self.planners[i].label, counts.join(" "))
+            })
+            .collect();
+        format!("  n/N runs reached all ROIs (per column): {}", parts.join("; "))
+    }
+
+    fn print_table(&self, out: &mut String, spec: &TableSpec) -> Result<()> {
+        writeln!(out, "Table {} (ours): {}", spec.id, spec.caption)?;
+        let mut header = vec![String::new()];
+        header.extend(
+            self.backends
+                .iter()
+                .map(|b| if b.2 == "–" { b.1.to_owned() } else { format!("{} ({})", b.1, b.2) }),
+        );
+        let mut rows = vec![header];
+        for i in self.shown_planners() {
+            for (suffix, format) in spec.rows {
+                let mut row = vec![format!("{}{suffix}", self.planners[i].label)];
+                row.extend(self.cells[i].iter().map(|c| match c {
+                    Cell::Cannot(_) => "–".to_owned(),
+                    Cell::Ran(_) => format(&c.successes()).unwrap_or_else(|| "none".to_owned()),
+                }));
+                rows.push(row);
+            }
+        }
+        out.push_str(&layout(&rows));
+        writeln!(out, "{}", self.successes_line())?;
+        writeln!(out, "Table {} (thesis): {}", spec.id, spec.caption)?;
+        let mut rows =
+            vec![std::iter::once("").chain(THESIS_BACKENDS).map(str::to_owned).collect()];
+        for (label, cells) in spec.thesis {
+            rows.push(
+                std::iter::once(*label).chain(cells.iter().copied()).map(str::to_owned).collect(),
+            );
+        }
+        out.push_str(&layout(&rows));
+        writeln!(out)?;
+        Ok(())
+    }
+}
+
+/// Runs the experiment and prints the tables, then the thesis's claims checked on our data.
+pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
+    if !args.problem.exists() {
+        bail!(
+            "{}: no such problem file (give --problem PATH; the default is the shared \
+             benchmark's floor plan, relative to the current directory)",
+            args.problem.display()
+        );
+    }
+    let p = read_problem(&args.problem)?;
+    let space = p.space().with_context(|| args.problem.display().to_string())?;
+    let query = p.query(&p.goals);
+    let patches = read_patches(&p)?;
+    for choice in &args.planners {
+        if !PLANNERS.iter().any(|r| r.choice == *choice) {
+            bail!("planner {choice:?} is not in the office experiment's list");
+        }
+    }
+    let planners: Vec<&PlannerRow> = PLANNERS
+        .iter()
+        .filter(|r| args.planners.is_empty() || args.planners.contains(&r.choice))
+        .collect();
+    let backends: Vec<_> = BACKENDS
+        .iter()
+        .filter(|b| args.backends.is_empty() || args.backends.contains(&b.0))
+        .collect();
+    let mut jsonl = match &args.jsonl {
+        Some(path) => Some(std::io::BufWriter::new(
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
+        )),
+        None => None,
+    };
+    let started = Instant::now();
+    let mut cells: Vec<Vec<Cell>> = planners.iter().map(|_| Vec::new()).collect();
+    let bar = progress.bar((planners.len() * backends.len()) as u64 * args.seeds, "runs");
+    for &&(backend, name, _) in &backends {
+        let map = map_from_patches(&p, patches.clone(), backend, args.sample_spacing)
+            .with_context(|| format!("building the `{name}` map"))?;
+        for (i, row) in planners.iter().enumerate() {
+            let mut runs = Vec::new();
+            let mut cannot = None;
+            for seed in 0..args.seeds {
+                bar.inc(1);
+                let mut planner = match make_planner(row.choice, &map, space, seed, p.goals.len()) {
+                    Ok(planner) => planner,
+                    Err(reason) => {
+                        if let Some(out) = &mut jsonl {
+                            let line = skipped_row(
+                                &p,
+                                row.choice,
+                                map.backend(),
+                                Mode::Roi,
+                                seed,
+                                &reason,
+                            );
+                            writeln!(out, "{line}")?;
+                        }
+                        cannot = Some(format!("{reason:#}"));
+                        continue;
+                    }
+                };
+                let outcome = solve_timed(planner.as_mut(), &query, Mode::Roi, args.max_iterations);
+                let paths: Vec<Option<Vec<Point3>>> =
+                    (0..p.goals.len()).map(|g| planner.path_to(g)).collect();
+                let all: Option<Vec<Vec<Point3>>> = paths.iter().cloned().collect();
+                let metrics = all.map(|paths| RunMetrics::of(outcome.1, &paths));
+                if let Some(out) = &mut jsonl {
+                    let mut line = run_row(
+                        &p,
+                        planner.as_ref() as &dyn Planner,
+                        map.backend(),
+                        Mode::Roi,
+                        seed,
+                        outcome,
+                        &paths,
+                    );
+                    line["experiment"] = json!("office");
+                    line["iteration_cap"] = json!(args.max_iterations);
+                    if let Some(m) = metrics {
+                        line["added_length"] = json!(m.length);
+                        line["steep_turns"] = json!(m.steep as u64);
+                        line["turns"] = json!(m.turns as u64);
+                        line["steep_ratio"] = json!(steep_ratio(m.steep, m.turns));
+                        line["curviness_deg"] = json!(m.curviness_deg);
+                    }
+                    writeln!(out, "{line}")?;
+                }
+                runs.push(metrics);
+            }
+            cells[i].push(match cannot {
+                Some(reason) if runs.is_empty() => Cell::Cannot(reason),
+                _ => Cell::Ran(runs),
+            });
+        }
+    }
+    bar.finish_and_clear();
+    if let Some(mut out) = jsonl {
+        out.flush()?;
+    }
+    let elapsed = started.elapsed().as_secs_f64();
+    let results = Results { planners, backends, cells };
+    let mut out = String::new();
+    writeln!(
+        out,
+        "Office experiment (thesis §5.5.3): problem `{}`, {} seeds (0..{}), iteration cap {}, \
+         {} of {} runs reached all {} ROIs; {elapsed:.1} s in all (planning and map building)",
+        p.name,
+        args.seeds,
+        args.seeds,
+        args.max_iterations,
+        results.cells.iter().flatten().map(|c| c.successes().len()).sum::<usize>(),
+        results
+            .cells
+            .iter()
+            .flatten()
+            .map(|c| match c {
+                Cell::Cannot(_) => 0,
+                Cell::Ran(runs) => runs.len(),
+            })
+            .sum::<usize>(),
+        p.goals.len(),
+    )?;
+    writeln!(
+        out,
+        "Columns: ours (thesis's counterpart): Simple = polygon, BB6D = bbox6d, OPCODE = trimesh \
+         (parry BVH), Bullet = rapier; pointcloud is ours only. \"–\": the planner cannot run \
+         on that map; \"none\": no run reached all ROIs. Statistics over successful runs only."
+    )?;
+    for note in results.skipped_planners() {
+        writeln!(out, "{note}")?;
+    }
+    writeln!(out)?;
+    for spec in TABLES {
+        results.print_table(&mut out, spec)?;
+    }
+    out.push_str(&claims(&results));
+    progress.say(out.trim_end());
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------------
+// The thesis's prose claims (spec §5.1 "Claims in the prose", §7.15), checked on the data.
+
+/// The thesis's five planners, its row order.
+const FIVE: [PlannerChoice; 5] = [P::Rrt, P::MaRrt, P::EvasionRrt, P::Prm, P::MaPrm];
+/// Our counterparts of the thesis's columns.
+const FOUR: [ProblemBackend; 4] = [B::Polygon, B::Bbox6d, B::Trimesh, B::Rapier];
+
+fn label(choice: PlannerChoice) -> &'static str {
+    PLANNERS.iter().find(|r| r.choice == choice).map_or("?", |r| r.label)
+}
+
+fn backend_name(backend: ProblemBackend) -> &'static str {
+    BACKENDS.iter().find(|b| b.0 == backend).map_or("?", |b| b.1)
+}
+
+/// A thesis table's number at planner `row` (index into [`FIVE`]) and column `col` (index into
+/// [`FOUR`]); `part` picks the `part`-th of "a/b/c". `None` for "–".
+fn thesis_value(table: ThesisTable, row: usize, col: usize, part: usize) -> Option<Real> {
+    let cell = table[row].1[col];
+    cell.split('/').nth(part)?.parse().ok()
+}
+
+/// One column of values for the claims: per planner of [`FIVE`], `Some(value)` where known.
+type Column = [Option<Real>; 5];
+
+fn argmin(col: &Column) -> Option<usize> {
+    (0..5)
+        .filter(|&i| col[i].is_some())
+        .min_by(|&a, &b| col[a].unwrap().total_cmp(&col[b].unwrap()))
+}
+
+fn argmax(col: &Column) -> Option<usize> {
+    (0..5)
+        .filter(|&i| col[i].is_some())
+        .max_by(|&a, &b| col[a].unwrap().total_cmp(&col[b].unwrap()))
+}
+
+fn yes(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
+/// Per column, `check` on the column's values (ours: our backends; thesis: its columns).
+fn per_column(
+    results: &Results<'_>,
+    ours: impl Fn(PlannerChoice, ProblemBackend) -> Option<Real>,
+    thesis: impl Fn(usize, usize) -> Option<Real>,
+    check: impl Fn(&Column) -> Option<String>,
+) -> (String, String) {
+    let thesis_parts: Vec<String> = (0..4)
+        .filter_map(|c| {
+            let col: Column = std::array::from_fn(|r| thesis(r, c));
+            check(&col).map(|s| format!("{} {s}", THESIS_BACKENDS[c]))
+        })
+        .collect();
+    let our_parts: Vec<String> = results
+        .backends
+        .iter()
+        .filter_map(|b| {
+            let col: Column = std::array::from_fn(|r| ours(FIVE[r], b.0));
+            check(&col).map(|s| format!("{} {s}", b.1))
+        })
+        .collect();
+    (thesis_parts.join(", "), our_parts.join(", "))
+}
+
+fn claim(out: &mut String, text: &str, (thesis, ours): (String, String)) {
+    let none = |s: String| if s.is_empty() { "no data".to_owned() } else { s };
+    let _ = writeln!(out, "- {text}\n    thesis: {}\n    ours:   {}", none(thesis), none(ours));
+}
+
+fn claims(r: &Results<'_>) -> String {
+    let mut out = String::from(
+        "Claims of the thesis's prose (spec §5.1, §7.15), checked on the thesis's tables and on \
+         ours (computed, over the thesis's five planners):\n",
+    );
+    let time = |m: &RunMetrics| m.time_s;
+    let length = |m: &RunMetrics| m.length;
+    let curv = |m: &RunMetrics| m.curviness_deg;
+    let t_time = |row, col| thesis_value(THESIS_5_3, row, col, 0);
+
+    claim(
+        &mut out,
+        "RRT is the fastest algorithm, PRM the runner-up (L6194–6196, Table 5.3)",
+        per_column(
+            r,
+            |p, b| r.median(p, b, time),
+            t_time,
+            |col| {
+                let fastest = argmin(col)?;
+                let mut rest = *col;
+                rest[fastest] = None;
+                let second = argmin(&rest);
+                let ok = fastest == 0 && second == Some(3);
+                let second = second.map_or("–", |i| THESIS_PLANNERS[i]);
+                Some(if ok {
+                    "yes".to_owned()
+                } else {
+                    format!("no ({} fastest, {second} second)", THESIS_PLANNERS[fastest])
+                })
+            },
+        ),
+    );
+    claim(
+        &mut out,
+        "All others are one or two orders of magnitude slower than RRT (L6196–6197): the \
+         smallest factor of MA RRT, Ev. RRT, MA PRM over RRT ≥ 10",
+        per_column(
+            r,
+            |p, b| r.median(p, b, time),
+            t_time,
+            |col| {
+                let rrt = col[0]?;
+                let min =
+                    [1, 2, 4].iter().filter_map(|&i| col[i]).map(|t| t / rrt).reduce(Real::min)?;
+                Some(format!("{} ({min:.1}×)", yes(min >= 10.0)))
+            },
+        ),
+    );
+    {
+        // Naive (Simple, BB6D) over Bullet, per planner: worst and best factor.
+        let factors = |value: &dyn Fn(usize, usize) -> Option<Real>, names: [&str; 2]| {
+            let mut all: Vec<(Real, String)> = Vec::new();
+            for (row, name) in THESIS_PLANNERS.iter().enumerate() {
+                for (c, col_name) in names.iter().enumerate() {
+                    if let (Some(naive), Some(bullet)) = (value(row, c), value(row, 3)) {
+                        all.push((naive / bullet, format!("{col_name}/{name}")));
+                    }
+                }
+            }
+            let worst = all.iter().max_by(|a, b| a.0.total_cmp(&b.0)).cloned();
+            let best = all.iter().min_by(|a, b| a.0.total_cmp(&b.0)).cloned();
+            match (worst, best) {
+                (Some(w), Some(b)) => format!(
+                    "worst {:.2} ({}), best {:.2} ({}); matches the claimed cells: {}",
+                    w.0,
+                    w.1,
+                    b.0,
+                    b.1,
+                    yes(w.1.ends_with("/MA PRM")
+                        && w.1.starts_with(names[0])
+                        && b.1.ends_with("/MA RRT")
+                        && b.1.starts_with(names[1]))
+                ),
+                _ => String::new(),
+            }
+        };
+        let ours = |row: usize, c: usize| r.median(FIVE[row], FOUR[c], time);
+        claim(
+            &mut out,
+            "Naive maps vs Bullet: factor 2.35 worst (Simple/MA PRM), 1.09 best (BB6D/MA RRT) \
+             (L6200–6204; §7.15: the table gives 2.90)",
+            (factors(&t_time, ["Simple", "BB6D"]), factors(&ours, ["polygon", "bbox6d"])),
+        );
+    }
+    {
+        let thesis = thesis_value(THESIS_5_3, 3, 2, 0)
+            .zip(thesis_value(THESIS_5_3, 3, 3, 0))
+            .map(|(o, b)| format!("OPCODE/Bullet PRM time {:.2}: {}", o / b, yes(o > b)));
+        let ours = r
+            .median(P::Prm, B::Trimesh, time)
+            .zip(r.median(P::Prm, B::Rapier, time))
+            .map(|(o, b)| format!("trimesh/rapier PRM time {:.2}: {}", o / b, yes(o > b)));
+        claim(
+            &mut out,
+            "OPCODE shows some weakness with PRM (L6199; §7.15: OPCODE's PRM is the fastest cell)",
+            (thesis.unwrap_or_default(), ours.unwrap_or_default()),
+        );
+    }
+    {
+        // Time spread (upper − lower)/median.
+        let spread = |q: [Real; 3]| (q[2] - q[0]) / q[1];
+        let t_spread = |row, col| {
+            Some(thesis_value(THESIS_5_4, row, col, 1)? - thesis_value(THESIS_5_4, row, col, 0)?)
+        };
+        claim(
+            &mut out,
+            "PRM has the largest variance of time (L6204–6205, Table 5.4): largest (upper − \
+             lower)/median",
+            per_column(
+                r,
+                |p, b| r.quartiles(p, b, time).map(spread),
+                t_spread,
+                |col| {
+                    let i = argmax(col)?;
+                    Some(if i == 3 {
+                        "yes".to_owned()
+                    } else {
+                        format!("no ({})", THESIS_PLANNERS[i])
+                    })
+                },
+            ),
+        );
+        let t_up = |row, col| thesis_value(THESIS_5_4, row, col, 1);
+        let t_lo = |row, col| thesis_value(THESIS_5_4, row, col, 0);
+        claim(
+            &mut out,
+            "MA PRM shows the smallest upward variance (L6205–6206): smallest upper/median",
+            per_column(
+                r,
+                |p, b| r.quartiles(p, b, time).map(|q| q[2] / q[1]),
+                t_up,
+                |col| {
+                    let i = argmin(col)?;
+                    Some(if i == 4 {
+                        "yes".to_owned()
+                    } else {
+                        format!("no ({})", THESIS_PLANNERS[i])
+                    })
+                },
+            ),
+        );
+        claim(
+            &mut out,
+            "MA PRM has the largest downward variance (L6206): smallest lower/median",
+            per_column(
+                r,
+                |p, b| r.quartiles(p, b, time).map(|q| q[0] / q[1]),
+                t_lo,
+                |col| {
+                    let i = argmin(col)?;
+                    Some(if i == 4 {
+                        "yes".to_owned()
+                    } else {
+                        format!("no ({})", THESIS_PLANNERS[i])
+                    })
+                },
+            ),
+        );
+        // Frameworks: the mean time spread of RRT and PRM (the planners every column runs).
+        let mean_spread = |value: &dyn Fn(usize, usize) -> Option<Real>, names: &[&str]| {
+            let spreads: Vec<(String, Real)> = (0..4)
+                .filter_map(|c| {
+                    let s = (value(0, c)? + value(3, c)?) / 2.0;
+                    Some((names[c].to_owned(), s))
+                })
+                .collect();
+            let most_stable = spreads.iter().min_by(|a, b| a.1.total_cmp(&b.1));
+            let list: Vec<String> =
+                spreads.iter().map(|(n, s)| format!("{n} {}", ratio(*s))).collect();
+            match most_stable {
+                Some((name, _)) => {
+                    format!("{}; most stable: {name} ({})", list.join(", "), yes(name == names[2]))
+                }
+                None => String::new(),
+            }
+        };
+        let ours = |row: usize, c: usize| r.quartiles(FIVE[row], FOUR[c], time).map(spread);
+        claim(
+            &mut out,
+            "Among the frameworks OPCODE is the most stable, Bullet and Simple vary most \
+             (L6207–6208): mean (upper − lower)/median of RRT and PRM time",
+            (
+                mean_spread(&t_spread, &THESIS_BACKENDS),
+                mean_spread(&ours, &["polygon", "bbox6d", "trimesh", "rapier"]),
+            ),
+        );
+    }
+    let t_len = |row, col| thesis_value(THESIS_5_5, row, col, 0);
+    claim(
+        &mut out,
+        "MA RRT produces the shortest paths, RRT's only marginally longer (L6214–6215, Table \
+         5.5): shortest median added length; RRT/MA RRT",
+        per_column(
+            r,
+            |p, b| r.median(p, b, length),
+            t_len,
+            |col| {
+                let i = argmin(col)?;
+                let factor = col[0].zip(col[1]).map(|(a, b)| format!(", RRT/MA RRT {:.3}", a / b));
+                Some(format!(
+                    "{}{}",
+                    if i == 1 { "yes".to_owned() } else { format!("no ({})", THESIS_PLANNERS[i]) },
+                    factor.unwrap_or_default()
+                ))
+            },
+        ),
+    );
+    claim(
+        &mut out,
+        "The PRM-based algorithms produce long paths (L6215–6216): PRM and MA PRM longer than \
+         every RRT variant",
+        per_column(
+            r,
+            |p, b| r.median(p, b, length),
+            t_len,
+            |col| {
+                let rrt_max = [0, 1, 2].iter().filter_map(|&i| col[i]).reduce(Real::max)?;
+                let prm_min = [3, 4].iter().filter_map(|&i| col[i]).reduce(Real::min)?;
+                Some(yes(prm_min > rrt_max).to_owned())
+            },
+        ),
+    );
+    let our_ratio = |p: PlannerChoice, b: ProblemBackend| {
+        let s = r.median(p, b, |m| m.steep)?;
+        Some(steep_ratio(s, r.median(p, b, |m| m.turns)?))
+    };
+    let t_ratio = |row, col| thesis_value(THESIS_5_7_TO_9, 3 * row, col, 2);
+    claim(
+        &mut out,
+        "PRM's paths have few turns, but 50% of them steep (L6282–6283, Table 5.7): PRM's \
+         median steep/total ratio, and the highest of the five",
+        per_column(r, our_ratio, t_ratio, |col| {
+            let prm = col[3]?;
+            Some(format!("{} {}", ratio(prm), yes(argmax(col) == Some(3))))
+        }),
+    );
+    claim(
+        &mut out,
+        "MA PRM produces less than half as many steep turns (as a share) as PRM, the RRT-based \
+         ones did better still (L6284–6287)",
+        per_column(r, our_ratio, t_ratio, |col| {
+            let half = col[4]? < col[3]? / 2.0;
+            let rrts_better = [0, 1, 2].iter().filter_map(|&i| col[i]).all(|x| x < col[4].unwrap());
+            Some(format!("{}/{}", yes(half), yes(rrts_better)))
+        }),
+    );
+    claim(
+        &mut out,
+        "Evasion RRT creates the smoothest paths (L6301): lowest median steep/total ratio",
+        per_column(r, our_ratio, t_ratio, |col| {
+            let i = argmin(col)?;
+            Some(if i == 2 { "yes".to_owned() } else { format!("no ({})", THESIS_PLANNERS[i]) })
+        }),
+    );
+    let t_curv = |row, col| thesis_value(THESIS_5_10, row, col, 0);
+    claim(
+        &mut out,
+        "Curviness: the RRT-based planners similar, MA PRM trails, PRM worst by far (L6361–6363, \
+         Table 5.10)",
+        per_column(
+            r,
+            |p, b| r.median(p, b, curv),
+            t_curv,
+            |col| {
+                let prm_worst = argmax(col) == Some(3);
+                let rrt_max = [0, 1, 2].iter().filter_map(|&i| col[i]).reduce(Real::max);
+                let ma_prm_trails = col[4].zip(rrt_max).map(|(m, r)| m > r);
+                Some(format!(
+                    "PRM worst {}, MA PRM behind the RRTs {}",
+                    yes(prm_worst),
+                    ma_prm_trails.map_or("–", yes)
+                ))
+            },
+        ),
+    );
+    {
+        let extremes = |values: Vec<(Real, Real, String)>| {
+            let lo = values.iter().min_by(|a, b| a.0.total_cmp(&b.0));
+            let up = values.iter().max_by(|a, b| a.1.total_cmp(&b.1));
+            match (lo, up) {
+                (Some(lo), Some(up)) => format!(
+                    "lowest lower/median {} ({}), highest upper/median {} ({})",
+                    ratio(lo.0),
+                    lo.2,
+                    ratio(up.1),
+                    up.2
+                ),
+                _ => String::new(),
+            }
+        };
+        let mut thesis = Vec::new();
+        let mut ours = Vec::new();
+        for (row, name) in THESIS_PLANNERS.iter().enumerate() {
+            for (c, col) in THESIS_BACKENDS.iter().enumerate() {
+                if let (Some(lo), Some(up)) =
+                    (thesis_value(THESIS_5_11, row, c, 0), thesis_value(THESIS_5_11, row, c, 1))
+                {
+                    thesis.push((lo, up, format!("{name}/{col}")));
+                }
+            }
+            for b in &r.backends {
+                if let Some(q) = r.quartiles(FIVE[row], b.0, curv) {
+                    ours.push((q[0] / q[1], q[2] / q[1], format!("{name}/{}", b.1)));
+                }
+            }
+        }
+        claim(
+            &mut out,
+            "Curviness varies little: lower quartile below 83% of the median only once (.791, \
+             MA RRT/Simple), upper above 110% only on OPCODE (L6367–6371, Table 5.11)",
+            (extremes(thesis), extremes(ours)),
+        );
+    }
+    claim(
+        &mut out,
+        "Bullet is the fastest implementation (L6383–6384; §7.15: OPCODE beats it where it \
+         runs): per planner, the fastest of the four thesis columns",
+        {
+            let thesis: Vec<String> = (0..5)
+                .map(|row| {
+                    let col: Column =
+                        std::array::from_fn(|c| (c < 4).then(|| t_time(row, c)).flatten());
+                    let best = argmin(&col).map_or("–", |c| THESIS_BACKENDS[c]);
+                    format!("{} {best}", THESIS_PLANNERS[row])
+                })
+                .collect();
+            let ours: Vec<String> = FIVE
+                .iter()
+                .map(|&p| {
+                    let col: Column = std::array::from_fn(|c| {
+                        (c < 4).then(|| r.median(p, FOUR[c], time)).flatten()
+                    });
+                    let best = argmin(&col).map_or("–", |c| backend_name(FOUR[c]));
+                    format!("{} {best}", label(p))
+                })
+                .collect();
+            let verdict = |v: &[String], bullet: &str| {
+                let all = v.iter().all(|s| s.ends_with(bullet) || s.ends_with(" –"));
+                format!("{}: {}", yes(all), v.join(", "))
+            };
+            (verdict(&thesis, " Bullet"), verdict(&ours, " rapier"))
+        },
+    );
+    {
+        // Same seed, same paths on every implementation of the patch map (L6186–6192); the
+        // point-cloud map is a different map (sampled points), so it is left out.
+        let mut parts = Vec::new();
+        for &p in &FIVE {
+            let per_backend: Vec<&Vec<Option<RunMetrics>>> = FOUR
+                .iter()
+                .filter_map(|&b| match r.cell(p, b)? {
+                    Cell::Ran(runs) => Some(runs),
+                    Cell::Cannot(_) => None,
+                })
+                .collect();
+            if per_backend.len() < 2 {
+                continue;
+            }
+            let seeds = per_backend[0].len();
+            let same = (0..seeds)
+                .filter(|&s| {
+                    let lengths: Vec<Option<Real>> =
+                        per_backend.iter().map(|runs| runs[s].map(|m| m.length)).collect();
+                    lengths.windows(2).all(|w| match (w[0], w[1]) {
+                        (Some(a), Some(b)) => (a - b).abs() <= 1e-9 * a.max(1.0),
+                        (None, None) => true,
+                        _ => false,
+                    })
+                })
+                .count();
+            parts.push(format!("{} {same}/{seeds}", label(p)));
+        }
+        claim(
+            &mut out,
+            "With the same seed all values but time should be the same on every map (L6186–6192): \
+             seeds whose added length agrees (1e-9) on all four patch-map backends",
+            (
+                "no: Table 5.5 differs between OPCODE and the others, and between the maps for \
+                 MA RRT, Ev. RRT and MA PRM"
+                    .to_owned(),
+                parts.join(", "),
+            ),
+        );
+    }
+    {
+        let ours: Vec<String> = r
+            .backends
+            .iter()
+            .filter_map(|b| match r.cell(P::MaPrm, b.0)? {
+                Cell::Ran(runs) => {
+                    Some(format!("{} {}/{}", b.1, runs.iter().flatten().count(), runs.len()))
+                }
+                Cell::Cannot(_) => None,
+            })
+            .collect();
+        claim(
+            &mut out,
+            "MA PRM reached all ROIs in 28 of 50 runs (Simple, BB6D, OPCODE) and 30 (Bullet) \
+             (L6141–6145; §7.15: OPCODE cannot run MA PRM); ours with one iteration cap, no \
+             binary search",
+            ("Simple 28/50, BB6D 28/50, Bullet 30/50".to_owned(), ours.join(", ")),
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantile_is_type_7_and_agrees_with_the_metrics_module() {
+        assert_eq!(quantile(&[], 0.5), None);
+        assert_eq!(quantile(&[4.0, 1.0, 3.0, 2.0], 0.5), Some(2.5));
+        assert_eq!(quantile(&[4.0, 1.0, 3.0, 2.0], 0.25), Some(1.75));
+        for values in [&[3.0][..], &[5.0, 1.0, 4.0, 2.0, 3.0], &[0.3, 0.1, 2.0, 7.5, 1.0, 1.0]] {
+            assert_eq!(quantile(values, 0.75), upper_quartile(values));
+        }
+    }
+
+    #[test]
+    fn numbers_print_as_in_the_thesis() {
+        assert_eq!(thesis_number(0.010057), ".010057");
+        assert_eq!(thesis_number(23.16080), "23.1608");
+        assert_eq!(thesis_number(1.966831), "1.96683");
+        assert_eq!(thesis_number(119.9031), "119.903");
+        assert_eq!(ratio(0.5471), ".547");
+        assert_eq!(ratio(1.8742), "1.874");
+        assert_eq!(count(3.0), "3");
+        assert_eq!(count(2.25), "2.25");
+        assert_eq!(count(30.5), "30.5");
+    }
+
+    #[test]
+    fn thesis_tables_parse_and_have_the_thesis_rows() {
+        for table in [THESIS_5_3, THESIS_5_4, THESIS_5_5, THESIS_5_6, THESIS_5_10, THESIS_5_11] {
+            let labels: Vec<&str> = table.iter().map(|r| r.0).collect();
+            assert_eq!(labels, THESIS_PLANNERS);
+        }
+        assert_eq!(THESIS_5_7_TO_9.len(), 15);
+        // The thesis's own ratios check out (3/20 = .150).
+        assert_eq!(thesis_value(THESIS_5_7_TO_9, 0, 0, 2), Some(0.15));
+        assert_eq!(thesis_value(THESIS_5_3, 1, 2, 0), None);
+        // §7.15: the worst naive/Bullet factor is 2.90, not 2.35.
+        let f =
+            thesis_value(THESIS_5_3, 4, 0, 0).unwrap() / thesis_value(THESIS_5_3, 4, 3, 0).unwrap();
+        assert!((f - 2.897).abs() < 1e-3);
+        // Every planner of the thesis has a row, in the thesis's order, before ours.
+        let first: Vec<&str> = PLANNERS.iter().take(5).map(|r| r.label).collect();
+        assert_eq!(first, THESIS_PLANNERS);
+    }
 }

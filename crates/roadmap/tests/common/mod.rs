@@ -83,3 +83,14 @@ pub fn same_roadmap(a: &Roadmap, b: &Roadmap) -> bool {
         .eq(b.edge_references().map(|e| (e.source(), e.target(), *e.weight())));
     nodes && edges
 }
+
+/// The roadmap is one tree: connected, acyclic, `n − 1` edges (or empty).
+pub fn assert_tree(graph: &Roadmap) {
+    let n = graph.node_count();
+    if n == 0 {
+        assert_eq!(graph.edge_count(), 0);
+        return;
+    }
+    assert_eq!(graph.edge_count(), n - 1, "a tree has n − 1 edges");
+    assert_eq!(petgraph::algo::connected_components(graph), 1, "a tree is connected");
+}

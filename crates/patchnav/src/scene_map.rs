@@ -1,0 +1,667 @@
+//! The thesis's four map types (§6.1, L6692–6700) built from a simulated scene, so the lab
+//! experiments (`patchnav experiment lab-timing`, `lab-volume`) have their maps:
+//!
+//! | kind | thesis (Lab dataset, 29 ALRF scans) | here (a `scene-sim` scene) |
+//! |---|---|---|
+//! | `planes` | planar patches extracted from the scans; the non-planar remainder dropped | every planar surface as a [`PlanarPatch`] (polygons with their holes, the six faces of each box, cylinder caps as regular polygons); spheres and cylinder sides dropped |
+//! | `hybrid` | planes + the remainder clouds as trimesh patches | `planes` + each curved surface (sphere, cylinder side) as one tessellated [`TrimeshPatch`] |
+//! | `trimesh` | every scan triangulated by naive trimesh growing (Alg. 4/5) | every surface triangulated (constrained Delaunay for planar ones) and split until no edge is longer than [`Tessellation::mesh_edge`], one [`TrimeshPatch`] per surface |
+//! | `pc` | the raw registered clouds | simulated full-resolution ALRF scans (SICK S300, 541 × 361 beams) from [`Scene::scan_poses`], in the world frame |
+//!
+//! **Not the thesis's pipeline.** The thesis built planes, hybrid and trimesh maps by patch
+//! extraction from the scans (plane segmentation, α-shapes, Douglas–Peucker, trimesh growing);
+//! that is separate, later work. Here they come from the scene's exact geometry, so the
+//! planes map is what a perfect extraction would give, and the trimesh map's triangle size
+//! stands in for the scan grid of naive trimesh growing (default 0.1 m: the thesis's Lab
+//! trimesh map has 65× the triangles of its planes map, Table 6.1). Only the `pc` map is
+//! made from (simulated) range data, with the sensor's noise.
+//!
+//! Curved surfaces are tessellated with vertices on the surface (inscribed), so a mesh lies
+//! up to `r·(1 − cos(π/n))` inside the true surface for `n` segments around.
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use patch_core::{
+    FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch,
+    Vector3,
+};
+use patch_map::triangulate::triangulate_polygon;
+use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
+use scene_sim::{Alrf, AlrfConfig, Cuboid, Cylinder, PlanarPolygon, RangeSensor, Scene, Shape};
+use std::collections::HashMap;
+use std::fmt;
+
+/// The map types of the thesis's Table 6.1.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, ValueEnum)]
+pub enum MapKind {
+    /// Planar patches only.
+    Planes,
+    /// Planar patches plus the curved surfaces as trimesh patches.
+    Hybrid,
+    /// Every surface as a fine triangle mesh.
+    Trimesh,
+    /// Simulated ALRF scans as a point-cloud map.
+    Pc,
+}
+
+impl MapKind {
+    /// All four, in the thesis's order of discussion.
+    pub const ALL: [MapKind; 4] = [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh, MapKind::Pc];
+
+    /// The lower-case name (`planes`, `hybrid`, `trimesh`, `pc`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MapKind::Planes => "planes",
+            MapKind::Hybrid => "hybrid",
+            MapKind::Trimesh => "trimesh",
+            MapKind::Pc => "pc",
+        }
+    }
+}
+
+impl fmt::Display for MapKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The backend a patch map (planes, hybrid, trimesh) is loaded into; the `pc` map is always a
+/// [`PointCloudMap`] (thesis §6.1: Algorithm 10, spec §7.12).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PatchBackend {
+    /// One parry triangle mesh with a BVH (the role of the thesis's Bullet maps).
+    Trimesh,
+    /// One rapier collider per patch (Bullet's collision world).
+    Rapier,
+    /// The 6D bounding-box k-d forest.
+    Bbox6d,
+    /// Native polygons, no broad phase.
+    Polygon,
+}
+
+impl PatchBackend {
+    /// The name on the command line (`trimesh`, `rapier`, `bbox6d`, `polygon`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PatchBackend::Trimesh => "trimesh",
+            PatchBackend::Rapier => "rapier",
+            PatchBackend::Bbox6d => "bbox6d",
+            PatchBackend::Polygon => "polygon",
+        }
+    }
+}
+
+/// How curved and meshed surfaces are triangulated. No `Default`: see [`Tessellation::lab`].
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Tessellation {
+    /// Longest edge of the tessellation of curved surfaces (spheres, cylinder sides, and the
+    /// regular polygons standing in for cylinder caps), metres.
+    pub curved_edge: Real,
+    /// Fewest segments around a sphere or cylinder (and vertices of a cap polygon).
+    pub min_segments: usize,
+    /// Longest triangle edge of the `trimesh` map, metres: every triangle of every surface is
+    /// split at its longest edge until no edge is longer.
+    pub mesh_edge: Real,
+    /// Most triangles in one trimesh patch of the `trimesh` map: a surface's mesh is cut into
+    /// spatially compact pieces of at most this many triangles, so backends with a per-patch
+    /// broad phase (bbox6d, rapier, polygon) keep one (the thesis's Lab trimesh map averages
+    /// 5,600,612 / 17,273 ≈ 324 triangles per patch, Table 6.1).
+    pub max_patch_triangles: usize,
+}
+
+impl Tessellation {
+    /// This command's choice for the lab: 0.1 m curved edges (the barrel gets 19 segments,
+    /// table legs 8), at least 8 segments, 0.1 m triangles in the trimesh map (a few hundred
+    /// thousand triangles; the thesis's naive trimesh growing made triangles at scan-grid size).
+    pub fn lab() -> Tessellation {
+        Tessellation { curved_edge: 0.1, min_segments: 8, mesh_edge: 0.1, max_patch_triangles: 324 }
+    }
+
+    fn check(&self) -> Result<()> {
+        for (what, v) in [("curved edge", self.curved_edge), ("mesh edge", self.mesh_edge)] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("the {what} must be a positive number of metres, got {v}");
+            }
+        }
+        if self.max_patch_triangles == 0 {
+            bail!("a trimesh patch needs room for at least one triangle");
+        }
+        if self.min_segments < 3 {
+            bail!("at least 3 segments are needed, got {}", self.min_segments);
+        }
+        Ok(())
+    }
+
+    /// Segments around a circle of radius `r`.
+    fn segments(&self, r: Real) -> usize {
+        let n = (std::f64::consts::TAU * r / self.curved_edge).ceil();
+        (n.min(100_000.0) as usize).max(self.min_segments)
+    }
+}
+
+/// How the `pc` map is scanned. No `Default`: the experiments set every field.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct ScanSetup {
+    /// Number of scan poses ([`Scene::scan_poses`]).
+    pub scans: usize,
+    /// Sensor height above the floor, metres.
+    pub height: Real,
+    /// Angular step of the ALRF in degrees; `None`: the S300's 0.5°.
+    pub step_deg: Option<Real>,
+    /// Seed of the poses and the sensor noise.
+    pub seed: u64,
+}
+
+/// A scene's surfaces, split into planar patches and tessellated curved surfaces.
+#[derive(Clone, Debug)]
+pub struct SceneSurfaces {
+    /// Every planar surface.
+    pub planar: Vec<PlanarPatch>,
+    /// Every curved surface (sphere, cylinder side), tessellated.
+    pub curved: Vec<TrimeshPatch>,
+}
+
+impl SceneSurfaces {
+    /// The surfaces of `scene`.
+    ///
+    /// # Errors
+    /// A polygon that is not a valid patch polygon (after turning holes that touch the
+    /// outline's bottom or top edge into notches), or a bad tessellation.
+    pub fn of(scene: &Scene, t: &Tessellation) -> Result<SceneSurfaces> {
+        t.check()?;
+        let mut planar = Vec::new();
+        let mut curved = Vec::new();
+        for primitive in scene.primitives() {
+            let name = &primitive.name;
+            match &primitive.shape {
+                Shape::Polygon(p) => planar
+                    .push(polygon_patch(p).with_context(|| format!("scene polygon `{name}`"))?),
+                Shape::Cuboid(c) => {
+                    for face in cuboid_faces(c) {
+                        planar.push(face.with_context(|| format!("a face of box `{name}`"))?);
+                    }
+                }
+                Shape::Sphere(s) => curved.push(
+                    sphere_mesh(s.center(), s.radius(), t)
+                        .with_context(|| format!("sphere `{name}`"))?,
+                ),
+                Shape::Cylinder(c) => {
+                    let (side, caps) =
+                        cylinder_surfaces(c, t).with_context(|| format!("cylinder `{name}`"))?;
+                    curved.push(side);
+                    planar.extend(caps);
+                }
+            }
+        }
+        Ok(SceneSurfaces { planar, curved })
+    }
+
+    /// The patches of a map kind (`None` for [`MapKind::Pc`], which has points).
+    ///
+    /// # Errors
+    /// A triangulation failure in the `trimesh` map.
+    pub fn patches(&self, kind: MapKind, t: &Tessellation) -> Result<Option<Vec<Patch>>> {
+        let planes = || self.planar.iter().cloned().map(Patch::from);
+        Ok(Some(match kind {
+            MapKind::Planes => planes().collect(),
+            MapKind::Hybrid => {
+                planes().chain(self.curved.iter().cloned().map(Patch::from)).collect()
+            }
+            MapKind::Trimesh => {
+                let mut out = Vec::with_capacity(self.planar.len() + self.curved.len());
+                let meshes = self.planar.iter().map(planar_triangles).chain(
+                    self.curved.iter().map(|m| Ok((m.vertices().to_vec(), m.triangles().to_vec()))),
+                );
+                for mesh in meshes {
+                    let (v, tri) = mesh?;
+                    let (v, tri) = subdivided(v, tri, t.mesh_edge)?;
+                    out.extend(
+                        chunked(&v, &tri, t.max_patch_triangles)?.into_iter().map(Patch::from),
+                    );
+                }
+                out
+            }
+            MapKind::Pc => return Ok(None),
+        }))
+    }
+}
+
+/// A built map with what it holds: one row of our Table 6.1 analogue.
+#[derive(Debug)]
+pub struct BuiltMap {
+    /// The map type.
+    pub kind: MapKind,
+    /// The map in its backend.
+    pub map: AnyMap,
+    /// Planar patches.
+    pub planar_patches: usize,
+    /// Trimesh patches.
+    pub trimesh_patches: usize,
+    /// Triangles: of the trimesh patches plus the constrained Delaunay triangulation of the
+    /// planar patches (as the thesis counts the triangles its Bullet maps hold).
+    pub triangles: usize,
+    /// Scans (point clouds) in a `pc` map.
+    pub point_clouds: usize,
+    /// Points in a `pc` map.
+    pub points: usize,
+}
+
+impl BuiltMap {
+    /// Heap bytes of the map in its backend ([`patch_map::MemoryUsage`]).
+    pub fn memory_bytes(&self) -> usize {
+        self.map.memory_bytes()
+    }
+}
+
+/// Builds the map of `kind` for `scene`: patch maps in `backend`, the `pc` map from `scans`.
+///
+/// # Errors
+/// As [`SceneSurfaces::of`], a backend refusing the patches or points, or no scan pose found.
+pub fn build_map(
+    scene: &Scene,
+    surfaces: &SceneSurfaces,
+    kind: MapKind,
+    backend: PatchBackend,
+    t: &Tessellation,
+    scans: &ScanSetup,
+) -> Result<BuiltMap> {
+    let Some(patches) = surfaces.patches(kind, t)? else {
+        let clouds = scan_points(scene, scans)?;
+        let points: Vec<Point3> = clouds.into_iter().flatten().collect();
+        let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
+        return Ok(BuiltMap {
+            kind,
+            map,
+            planar_patches: 0,
+            trimesh_patches: 0,
+            triangles: 0,
+            point_clouds: scans.scans,
+            points: points.len(),
+        });
+    };
+    let mut built = BuiltMap {
+        kind,
+        map: AnyMap::Polygon(PolygonMap::from_patches(Vec::new())?),
+        planar_patches: 0,
+        trimesh_patches: 0,
+        triangles: 0,
+        point_clouds: 0,
+        points: 0,
+    };
+    for p in &patches {
+        match p {
+            Patch::Planar(p) => {
+                built.planar_patches += 1;
+                built.triangles += planar_triangles(p)?.1.len();
+            }
+            Patch::Trimesh(m) => {
+                built.trimesh_patches += 1;
+                built.triangles += m.num_triangles();
+            }
+        }
+    }
+    built.map = patch_map(patches, backend)?;
+    Ok(built)
+}
+
+/// Loads `patches` into `backend`.
+pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
+    Ok(match backend {
+        PatchBackend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
+        PatchBackend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
+        PatchBackend::Bbox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
+        PatchBackend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
+    })
+}
+
+/// Simulated ALRF scans of `scene` from [`Scene::scan_poses`], each in the world frame.
+///
+/// # Errors
+/// A bad angular step, or fewer poses than asked for.
+pub fn scan_points(scene: &Scene, setup: &ScanSetup) -> Result<Vec<Vec<Point3>>> {
+    let config = match setup.step_deg {
+        None => AlrfConfig::sick_s300(),
+        Some(step) => AlrfConfig::sick_s300_with_step(step.to_radians())
+            .with_context(|| format!("ALRF step {step}°"))?,
+    };
+    let alrf = Alrf::new(config)?;
+    let bodies = scene.scan_poses(setup.scans, setup.height, setup.seed);
+    if bodies.len() < setup.scans {
+        bail!(
+            "scene `{}` has room for only {} scan poses at height {} m",
+            scene.name(),
+            bodies.len(),
+            setup.height
+        );
+    }
+    bodies
+        .iter()
+        .enumerate()
+        .map(|(i, body)| {
+            let seed = scene_sim::sensors::derive_seed(setup.seed, i as u64);
+            let scan = alrf.scan(scene, &alrf.mount(body), seed);
+            let cloud = scan.to_cloud().context("building a scan's cloud")?.to_world();
+            Ok(cloud.positions().to_vec())
+        })
+        .collect()
+}
+
+/// The patch of a scene polygon. A hole touching the outline (a door reaching the floor) is
+/// invalid for a patch polygon; for an axis-aligned rectangle with rectangular holes, such
+/// holes on the bottom or top edge become notches of the outline.
+fn polygon_patch(p: &PlanarPolygon) -> Result<PlanarPatch> {
+    let holes: Vec<Vec<Point2>> = p.holes().map(<[Point2]>::to_vec).collect();
+    let polygon = match Polygon::new(p.outline().to_vec(), holes.clone()) {
+        Ok(polygon) => polygon,
+        Err(e) => {
+            let Some((outline, holes)) = notched(p.outline(), &holes) else {
+                return Err(e.into());
+            };
+            Polygon::new(outline, holes)?
+        }
+    };
+    Ok(PlanarPatch::new(polygon, *p.world_from_patch())?)
+}
+
+/// The corners `(min, max)` of an axis-aligned rectangle ring, `None` for any other ring.
+fn rectangle(ring: &[Point2]) -> Option<(Point2, Point2)> {
+    if ring.len() != 4 {
+        return None;
+    }
+    let lo = ring.iter().fold(ring[0], |m, p| m.inf(p));
+    let hi = ring.iter().fold(ring[0], |m, p| m.sup(p));
+    let on_corner = |q: &Point2| (q.x == lo.x || q.x == hi.x) && (q.y == lo.y || q.y == hi.y);
+    ring.iter().all(on_corner).then_some((lo, hi))
+}
+
+/// The outline of a rectangle with its bottom- and top-touching rectangular holes cut in as
+/// notches, and the other holes; `None` if the rings are not all axis-aligned rectangles or a
+/// hole touches a side edge.
+fn notched(outline: &[Point2], holes: &[Vec<Point2>]) -> Option<(Vec<Point2>, Vec<Vec<Point2>>)> {
+    let (lo, hi) = rectangle(outline)?;
+    let boxes: Vec<(Point2, Point2)> = holes.iter().map(|h| rectangle(h)).collect::<Option<_>>()?;
+    if boxes.iter().any(|(a, b)| a.x <= lo.x || b.x >= hi.x) {
+        return None;
+    }
+    let mut bottom: Vec<_> = boxes.iter().filter(|(a, _)| a.y <= lo.y).collect();
+    let mut top: Vec<_> = boxes.iter().filter(|(a, b)| a.y > lo.y && b.y >= hi.y).collect();
+    bottom.sort_by(|p, q| p.0.x.total_cmp(&q.0.x));
+    top.sort_by(|p, q| q.0.x.total_cmp(&p.0.x));
+    // Counter-clockwise: along the bottom eastwards, up, along the top westwards.
+    let mut ring = vec![lo];
+    for (a, b) in bottom {
+        let up = b.y.min(hi.y);
+        ring.extend([Point2::new(a.x, lo.y), Point2::new(a.x, up), Point2::new(b.x, up)]);
+        ring.push(Point2::new(b.x, lo.y));
+    }
+    ring.extend([Point2::new(hi.x, lo.y), hi]);
+    for (a, b) in top {
+        ring.extend([Point2::new(b.x, hi.y), Point2::new(b.x, a.y), Point2::new(a.x, a.y)]);
+        ring.push(Point2::new(a.x, hi.y));
+    }
+    ring.push(Point2::new(lo.x, hi.y));
+    ring.dedup();
+    let inner = boxes
+        .iter()
+        .filter(|(a, b)| a.y > lo.y && b.y < hi.y)
+        .map(|(a, b)| vec![*a, Point2::new(b.x, a.y), *b, Point2::new(a.x, b.y)])
+        .collect();
+    Some((ring, inner))
+}
+
+/// A planar patch through world points given counter-clockwise seen from `normal`'s side.
+fn world_patch(mut ring: Vec<Point3>, normal: &Vector3) -> Result<PlanarPatch> {
+    let newell = (0..ring.len()).fold(Vector3::zeros(), |n, i| {
+        let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
+        n + a.coords.cross(&b.coords)
+    });
+    if newell.dot(normal) < 0.0 {
+        ring.reverse();
+    }
+    Ok(PlanarPatch::from_world_polygon(&ring, &[], 1e-9)?)
+}
+
+/// The six faces of a box as planar patches, normals outwards.
+fn cuboid_faces(c: &Cuboid) -> impl Iterator<Item = Result<PlanarPatch>> + '_ {
+    let axes = c.world_from_box().rotation.to_rotation_matrix().into_inner();
+    let h = *c.half_extents();
+    (0..6u32).map(move |part| {
+        let a = (part / 2) as usize;
+        let (i, j) = ((a + 1) % 3, (a + 2) % 3);
+        let u: Vector3 = axes.column(i) * h[i];
+        let v: Vector3 = axes.column(j) * h[j];
+        let centre = c.face_center(part);
+        let ring = vec![centre - u - v, centre + u - v, centre + u + v, centre - u + v];
+        world_patch(ring, &c.face_normal(part))
+    })
+}
+
+/// The side of a cylinder as a mesh and its two caps as regular polygons.
+fn cylinder_surfaces(c: &Cylinder, t: &Tessellation) -> Result<(TrimeshPatch, [PlanarPatch; 2])> {
+    let m: &Isometry3 = c.world_from_cylinder();
+    let (r, h) = (c.radius(), c.half_height());
+    let n = t.segments(r);
+    let rings = ((2.0 * h / t.curved_edge).ceil() as usize).max(1);
+    let at = |k: usize, z: Real| {
+        let a = std::f64::consts::TAU * k as Real / n as Real;
+        m * Point3::new(r * a.cos(), r * a.sin(), z)
+    };
+    let mut vertices = Vec::with_capacity(n * (rings + 1));
+    for j in 0..=rings {
+        let z = -h + 2.0 * h * j as Real / rings as Real;
+        vertices.extend((0..n).map(|k| at(k, z)));
+    }
+    let mut triangles = Vec::with_capacity(2 * n * rings);
+    for j in 0..rings {
+        for k in 0..n {
+            let (a, b) = ((j * n + k) as u32, (j * n + (k + 1) % n) as u32);
+            let (c2, d) = (a + n as u32, b + n as u32);
+            triangles.push([a, b, d]);
+            triangles.push([a, d, c2]);
+        }
+    }
+    let side = TrimeshPatch::new(vertices, triangles)?;
+    let axis = c.axis();
+    let bottom = world_patch((0..n).map(|k| at(k, -h)).collect(), &-axis)?;
+    let top = world_patch((0..n).map(|k| at(k, h)).collect(), &axis)?;
+    Ok((side, [bottom, top]))
+}
+
+/// A sphere as a latitude–longitude mesh.
+fn sphere_mesh(centre: &Point3, r: Real, t: &Tessellation) -> Result<TrimeshPatch> {
+    let n = t.segments(r);
+    let lat = (n / 2).max(2);
+    let mut vertices = vec![centre + Vector3::z() * r, centre - Vector3::z() * r];
+    for j in 1..lat {
+        let polar = std::f64::consts::PI * j as Real / lat as Real;
+        for k in 0..n {
+            let a = std::f64::consts::TAU * k as Real / n as Real;
+            let d = Vector3::new(polar.sin() * a.cos(), polar.sin() * a.sin(), polar.cos());
+            vertices.push(centre + d * r);
+        }
+    }
+    let ring = |j: usize, k: usize| (2 + (j - 1) * n + k % n) as u32;
+    let mut triangles = Vec::new();
+    for k in 0..n {
+        triangles.push([0, ring(1, k), ring(1, k + 1)]);
+        triangles.push([1, ring(lat - 1, k + 1), ring(lat - 1, k)]);
+        for j in 1..lat - 1 {
+            let (a, b) = (ring(j, k), ring(j, k + 1));
+            let (c, d) = (ring(j + 1, k), ring(j + 1, k + 1));
+            triangles.push([a, c, d]);
+            triangles.push([a, d, b]);
+        }
+    }
+    Ok(TrimeshPatch::new(vertices, triangles)?)
+}
+
+/// The constrained Delaunay triangulation of a planar patch, in the world.
+fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+    let rings: Vec<Vec<[f64; 2]>> =
+        p.polygon().rings().map(|r| r.points().iter().map(|q| [q.x, q.y]).collect()).collect();
+    let t = triangulate_polygon(&rings)?;
+    let vertices = t.vertices.iter().map(|&[x, y]| p.to_world(&Point2::new(x, y))).collect();
+    Ok((vertices, t.triangles))
+}
+
+/// Most triangles one surface may be split into (a guard against a tiny `mesh_edge`).
+const MAX_TRIANGLES_PER_SURFACE: usize = 20_000_000;
+
+/// The mesh with every triangle split at the midpoint of its longest edge until no edge is
+/// longer than `max_edge` (midpoints shared by the triangles on both sides of an edge). The
+/// triangles come out depth first, so consecutive ones lie close together.
+fn subdivided(
+    mut vertices: Vec<Point3>,
+    triangles: Vec<[u32; 3]>,
+    max_edge: Real,
+) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+    let key = |p: &Point3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let mut index: HashMap<[u64; 3], u32> =
+        vertices.iter().enumerate().map(|(i, p)| (key(p), i as u32)).collect();
+    let mut stack = triangles;
+    let mut out = Vec::new();
+    let limit = max_edge * max_edge;
+    while let Some(t) = stack.pop() {
+        let p = t.map(|i| vertices[i as usize]);
+        let len = |e: usize| (p[(e + 1) % 3] - p[e]).norm_squared();
+        let e = (0..3).max_by(|&a, &b| len(a).total_cmp(&len(b))).unwrap_or(0);
+        if len(e) <= limit {
+            out.push(t);
+            if out.len() > MAX_TRIANGLES_PER_SURFACE {
+                bail!("a surface needs more than {MAX_TRIANGLES_PER_SURFACE} triangles");
+            }
+            continue;
+        }
+        let (a, b, c) = (t[e], t[(e + 1) % 3], t[(e + 2) % 3]);
+        let m = Point3::from((p[e].coords + p[(e + 1) % 3].coords) * 0.5);
+        let mi = *index.entry(key(&m)).or_insert_with(|| {
+            vertices.push(m);
+            (vertices.len() - 1) as u32
+        });
+        stack.push([a, mi, c]);
+        stack.push([mi, b, c]);
+    }
+    Ok((vertices, out))
+}
+
+/// The mesh cut into patches of at most `max` consecutive triangles, each with its own
+/// vertices.
+fn chunked(vertices: &[Point3], triangles: &[[u32; 3]], max: usize) -> Result<Vec<TrimeshPatch>> {
+    let patches = triangles.chunks(max.max(1)).map(|chunk| {
+        let mut local: HashMap<u32, u32> = HashMap::new();
+        let mut v = Vec::new();
+        let t: Vec<[u32; 3]> = chunk
+            .iter()
+            .map(|tri| {
+                tri.map(|i| {
+                    *local.entry(i).or_insert_with(|| {
+                        v.push(vertices[i as usize]);
+                        (v.len() - 1) as u32
+                    })
+                })
+            })
+            .collect();
+        TrimeshPatch::new(v, t)
+    });
+    Ok(patches.collect::<Result<_, _>>()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use scene_sim::{Material, SceneBuilder, Sphere};
+
+    fn one_box() -> Scene {
+        let mut b = SceneBuilder::new("one box");
+        let c = Cuboid::new(
+            Isometry3::new(Vector3::new(1.0, 2.0, 0.5), Vector3::new(0.1, 0.2, 0.7)),
+            Vector3::new(0.5, 1.0, 1.5),
+        )
+        .unwrap();
+        b.add("box", c, Material::WOOD).unwrap();
+        b.build().unwrap()
+    }
+
+    fn area(patches: &[Patch]) -> Real {
+        patches.iter().map(Patch::area).sum()
+    }
+
+    #[test]
+    fn planes_of_one_box_are_its_six_faces() {
+        let t = Tessellation::lab();
+        let s = SceneSurfaces::of(&one_box(), &t).unwrap();
+        let planes = s.patches(MapKind::Planes, &t).unwrap().unwrap();
+        assert_eq!(planes.len(), 6);
+        assert!(planes.iter().all(|p| p.as_planar().is_some()));
+        // 2·(1·2 + 1·3 + 2·3) = 22 m².
+        assert!((area(&planes) - 22.0).abs() < 1e-9, "{}", area(&planes));
+        // Each face's normal points away from the box centre.
+        let centre = Point3::new(1.0, 2.0, 0.5);
+        for p in &planes {
+            let p = p.as_planar().unwrap();
+            let on = p.to_world(&p.polygon().outer().points()[0]);
+            assert!(p.normal().dot(&(on - centre)) > 0.0);
+        }
+    }
+
+    #[test]
+    fn hybrid_contains_planes_and_trimesh_covers_the_same_area() {
+        let mut b = SceneBuilder::new("mixed");
+        b.add("floor", one_box().primitives()[0].shape.clone(), Material::WOOD).unwrap();
+        b.add("ball", Sphere::new(Point3::new(4.0, 0.0, 1.0), 0.5).unwrap(), Material::WOOD)
+            .unwrap();
+        let cyl = Cylinder::upright(Point3::new(-3.0, 0.0, 0.0), 0.3, 1.0).unwrap();
+        b.add("barrel", cyl, Material::WOOD).unwrap();
+        let scene = b.build().unwrap();
+        let t = Tessellation {
+            curved_edge: 0.2,
+            min_segments: 8,
+            mesh_edge: 0.25,
+            max_patch_triangles: 50,
+        };
+        let s = SceneSurfaces::of(&scene, &t).unwrap();
+        let planes = s.patches(MapKind::Planes, &t).unwrap().unwrap();
+        let hybrid = s.patches(MapKind::Hybrid, &t).unwrap().unwrap();
+        let trimesh = s.patches(MapKind::Trimesh, &t).unwrap().unwrap();
+        assert_eq!(planes.len(), 6 + 2, "box faces and cylinder caps");
+        assert_eq!(hybrid.len(), planes.len() + 2, "plus sphere and cylinder side");
+        for p in &planes {
+            assert!(hybrid.contains(p), "hybrid ⊇ planes");
+        }
+        assert!(trimesh.iter().all(|p| p.as_trimesh().is_some()));
+        assert!(trimesh.len() > hybrid.len(), "surfaces cut into patches of ≤ 50 triangles");
+        let triangles = |p: &Patch| p.as_trimesh().unwrap().num_triangles();
+        assert!(trimesh.iter().all(|p| triangles(p) <= 50));
+        assert!((area(&trimesh) - area(&hybrid)).abs() < 1e-6 * area(&hybrid));
+        for p in &trimesh {
+            for [a, b, c] in
+                p.as_trimesh().unwrap().triangles().iter().map(|t| t.map(|i| i as usize))
+            {
+                let v = p.as_trimesh().unwrap().vertices();
+                for (x, y) in [(a, b), (b, c), (c, a)] {
+                    assert!((v[x] - v[y]).norm() <= 0.25 + 1e-12);
+                }
+            }
+        }
+        // The tessellated sphere is inscribed: a little less than 4πr².
+        let sphere_area = hybrid.iter().filter_map(Patch::as_trimesh).next().unwrap().area();
+        let exact = 4.0 * std::f64::consts::PI * 0.25;
+        assert!(sphere_area < exact && sphere_area > 0.9 * exact, "{sphere_area}");
+    }
+
+    #[test]
+    fn door_touching_the_floor_becomes_a_notch() {
+        let lab = scene_sim::lab(0).unwrap();
+        let t = Tessellation::lab();
+        let s = SceneSurfaces::of(&lab, &t).unwrap();
+        let Shape::Polygon(south) =
+            &lab.primitives().iter().find(|p| p.name == "wall-south").unwrap().shape
+        else {
+            panic!("the south wall is a polygon");
+        };
+        let patch = polygon_patch(south).unwrap();
+        assert!((patch.area() - (12.0 * 4.0 - 1.2 * 2.1)).abs() < 1e-9);
+        assert!((patch.area() - south.area()).abs() < 1e-9);
+        assert!(!s.planar.is_empty() && !s.curved.is_empty());
+    }
+}
