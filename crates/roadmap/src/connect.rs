@@ -13,21 +13,27 @@ use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roa
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
 
-/// RRT-Connect (Kuffner & LaValle 2000) for problems with at most one goal; not part of the
-/// thesis, a baseline from the literature.
+/// RRT-Connect (Kuffner & LaValle 2000), extended to several goals; not part of the thesis, a
+/// baseline from the literature.
 ///
-/// One tree grows from the start, one from the goal centre. Each iteration draws a uniform
+/// One tree grows from the start and one from each goal centre. Each iteration draws a uniform
 /// sample `x` in the bounds and EXTENDs one tree one step toward it (the RRT's step rule:
 /// `min(max_step, |x − x_near|)` along `x − x_near`, added if the capsule is free); if a
-/// vertex was added, the other tree CONNECTs to it: it takes such steps toward that vertex
-/// until the last (at most `max_step` long) edge joins the two trees or a step collides. Then
-/// the trees swap roles. The goal is reached when the trees join (the path ends at the goal
-/// centre) or when a vertex of the start tree lies within the goal's tolerance. After that,
-/// iterations grow the start tree alone, like the RRT.
+/// vertex was added, the partner tree CONNECTs to it: it takes such steps toward that vertex
+/// until the last (at most `max_step` long) edge joins the two trees or a step collides.
 ///
-/// A problem with more than one goal gives [`PlannerStatus::InvalidGoal`]; with no goal only
-/// the start tree grows. The roadmap holds both trees (a forest until they join); vertices of
-/// the goal tree count as explored (for [`PlannerStatus::Approximate`]) only once joined.
+/// With one goal this is Kuffner and LaValle's algorithm: the start tree and the goal tree
+/// swap roles every iteration. With `k` goals the start tree is paired with the goal trees in
+/// turn (round robin over the goals not yet reached): one iteration the start tree extends
+/// and the current goal tree connects, the next the goal tree extends and the start tree
+/// connects, then the next goal's turn. A goal tree that joins the start tree becomes part of
+/// it (so later goals can connect to everything reached so far) and its goal is reached (the
+/// path ends at the goal centre); a goal is also reached when a vertex of the start tree lies
+/// within its tolerance. Once every goal is reached, iterations grow the start tree alone,
+/// like the RRT; with no goal only the start tree grows.
+///
+/// The roadmap holds every tree (a forest until they join); vertices of a goal tree count as
+/// explored (for [`PlannerStatus::Approximate`]) only once joined.
 ///
 /// Needs only [`UnspecificStepIntersector<CapsuleStep>`].
 pub struct RrtConnect<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
@@ -93,29 +99,36 @@ impl Tree {
     }
 }
 
-/// The working state: the solution, both trees, which nodes are connected to the start.
+/// The working state: the solution, the trees (0: the start's, then one per goal with a goal
+/// tree), and which tree each vertex belongs to.
 struct State<'s> {
     solution: &'s mut Solution,
-    trees: [Tree; 2],
-    in_start: Vec<bool>,
+    trees: Vec<Tree>,
+    tree_of: Vec<usize>,
 }
 
 impl State<'_> {
     fn add(&mut self, tree: usize, p: Point3) -> NodeIndex {
         let v = self.solution.graph.add_node(p);
         self.trees[tree].push(v, p);
-        self.in_start.push(tree == 0);
+        self.tree_of.push(tree);
         v
     }
 
-    /// Marks the goal reached by `v` if `v` is in the start tree and within tolerance.
+    fn in_start(&self, v: NodeIndex) -> bool {
+        self.tree_of[v.index()] == 0
+    }
+
+    /// Marks every goal reached by `v` if `v` is in the start tree and within tolerance.
     fn test_goal(&mut self, v: NodeIndex) {
-        if let (Some(goal), Some(None)) =
-            (self.solution.goals.first(), self.solution.reached.first())
-            && self.in_start[v.index()]
-            && (self.solution.graph[v] - goal.center).norm() <= goal.tolerance
-        {
-            self.solution.reached[0] = Some(v);
+        if !self.in_start(v) {
+            return;
+        }
+        let p = self.solution.graph[v];
+        for (goal, reached) in self.solution.goals.iter().zip(&mut self.solution.reached) {
+            if reached.is_none() && (p - goal.center).norm() <= goal.tolerance {
+                *reached = Some(v);
+            }
         }
     }
 }
@@ -187,51 +200,71 @@ fn solve_connect<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     let started = Instant::now();
     solution.reset(&problem.goals);
     let mut checker = Checker::new(map, space.robot_radius());
-    if problem.goals.len() > 1 {
-        solution.finish(0, &checker);
-        return PlannerStatus::InvalidGoal;
-    }
     if let Some(invalid) = planner::validate(problem, space, &mut checker) {
         solution.finish(0, &checker);
         return invalid;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut state = State { solution, trees: [Tree::default(), Tree::default()], in_start: vec![] };
+    let mut state = State { solution, trees: vec![Tree::default()], tree_of: vec![] };
     let start = state.add(0, problem.start);
     state.test_goal(start);
-    let goal_root = match problem.goals.first() {
-        Some(goal) if state.solution.reached[0].is_none() => Some(state.add(1, goal.center)),
-        _ => None,
-    };
-    // The tree that extends next (0: start, 1: goal); the other one connects.
-    let mut active = 0;
+    // One tree per goal not reached by the start itself: (goal, its tree, the goal's root).
+    let mut open: Vec<(usize, usize, NodeIndex)> = Vec::new();
+    for (g, goal) in problem.goals.iter().enumerate() {
+        if state.solution.reached[g].is_none() {
+            state.trees.push(Tree::default());
+            let tree = state.trees.len() - 1;
+            open.push((g, tree, state.add(tree, goal.center)));
+        }
+    }
+    // `turn` picks the goal tree paired with the start tree; `start_extends` which of the
+    // pair extends (the other connects).
+    let mut turn = 0usize;
+    let mut start_extends = true;
     let mut iterations = 0u64;
     while !stop.should_stop(&state.solution.progress(iterations, started)) {
         iterations += 1;
         let x = planner::uniform(&mut rng, space);
-        if state.solution.reached.iter().all(Option::is_some) {
+        // Goals reached by a start-tree vertex within tolerance leave the rotation.
+        open.retain(|&(g, _, _)| state.solution.reached[g].is_none());
+        if open.is_empty() {
             extend(&mut state, &mut checker, space, 0, &x);
             continue;
         }
-        if let Step::Advanced(v) = extend(&mut state, &mut checker, space, active, &x)
-            && connect(&mut state, &mut checker, space, 1 - active, v)
+        turn %= open.len();
+        let (goal, tree, root) = open[turn];
+        let (extending, connecting) = if start_extends { (0, tree) } else { (tree, 0) };
+        if let Step::Advanced(v) = extend(&mut state, &mut checker, space, extending, &x)
+            && connect(&mut state, &mut checker, space, connecting, v)
         {
-            join(&mut state);
-            state.solution.reached[0] = goal_root;
+            join(&mut state, tree);
+            if state.solution.reached[goal].is_none() {
+                state.solution.reached[goal] = Some(root);
+            }
+            open.remove(turn);
+            start_extends = true;
+            continue;
         }
-        active = 1 - active;
+        start_extends = !start_extends;
+        if start_extends {
+            turn += 1;
+        }
     }
-    let State { solution, in_start, .. } = state;
+    let State { solution, tree_of, .. } = state;
     solution.finish(iterations, &checker);
-    solution.status(|v| in_start[v.index()])
+    solution.status(|v| tree_of[v.index()] == 0)
 }
 
-/// Moves the goal tree into the start tree once they are joined.
-fn join(state: &mut State<'_>) {
-    let goal_tree = std::mem::take(&mut state.trees[1]);
-    for v in goal_tree.nodes {
+/// Moves goal tree `tree` into the start tree once they are joined.
+fn join(state: &mut State<'_>, tree: usize) {
+    let goal_tree = std::mem::take(&mut state.trees[tree]);
+    for &v in &goal_tree.nodes {
         let p = state.solution.graph[v];
         state.trees[0].push(v, p);
-        state.in_start[v.index()] = true;
+        state.tree_of[v.index()] = 0;
+    }
+    // Vertices the start tree just took over may lie within other goals' tolerance.
+    for v in goal_tree.nodes {
+        state.test_goal(v);
     }
 }

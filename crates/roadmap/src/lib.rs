@@ -100,12 +100,18 @@
 //!   is a greedy pass plus random shortcuts ([`ShortcutConfig::standard`] documents this
 //!   crate's values). It never lengthens a path and adds only segments the map reported free.
 //!
+//! # Explored volume ([`volume`], thesis §6.1.1)
+//! Roadmaps are rasterised into a sparse voxel grid ([`volume::VoxelGrid`], 1024³ cells over
+//! the common bounds by default): a voxel counts iff its centre lies within the robot radius of
+//! a vertex or an edge, decided exactly ([`volume::capsule_contains_point`]); unions over runs
+//! and the thesis's congruence table "explored on A but not on B, in % of A"
+//! ([`volume::CongruenceTable`], Tables 6.2–6.5). The experiments that use it are in the
+//! `patchnav experiment` command.
+//!
 //! # Not yet here
-//! Path smoothing other than shortcutting (e.g. splines), roadmap
-//! metrics (only path metrics exist), the explored volume, the thesis's
-//! experiments, benchmarks, and a choice of nearest-neighbour structure per planner (all use
-//! [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL k-d tree for PRM, §6.1).
-//! [`RrtConnect`] handles at most one goal.
+//! Path smoothing other than shortcutting (e.g. splines), a choice of nearest-neighbour
+//! structure per planner (all use [`KdNeighbors`]; the thesis used an octree for RRT and a CGAL
+//! k-d tree for PRM, §6.1).
 //!
 //! # Example
 //! ```

@@ -44,8 +44,6 @@ fn goals_start_and_termination() {
     let problem = across(0.0);
     let mut p = RrtConnect::new(&map, space(0.5), 1);
     assert_eq!(p.name(), "rrt-connect");
-    let two = Problem { goals: vec![problem.goals[0]; 2], ..problem.clone() };
-    assert_eq!(p.solve(&two, &mut MaxIterations(10)), PlannerStatus::InvalidGoal);
     let bad_start = Problem { start: Point3::new(2.9, 3.0, 1.25), ..problem.clone() };
     assert_eq!(p.solve(&bad_start, &mut MaxIterations(10)), PlannerStatus::InvalidStart);
     assert_eq!(p.roadmap().node_count(), 0);
@@ -92,6 +90,34 @@ impl Termination for Recorder {
 }
 
 #[test]
+fn reaches_several_goals_on_both_sides_of_the_wall() {
+    let map = wall_with_door();
+    let goal = |x: Real, y: Real| Goal { center: Point3::new(x, y, 1.25), tolerance: 0.0 };
+    let problem = Problem {
+        start: Point3::new(1.0, 2.0, 1.25),
+        goals: vec![goal(5.0, 2.0), goal(0.5, 3.5), goal(5.5, 0.5), goal(4.0, 3.5)],
+    };
+    for seed in 0..8 {
+        let mut p = RrtConnect::new(&map, space(0.5), seed);
+        assert_eq!(p.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact, "{seed}");
+        assert_all_free(&map, &p, problem.goals.len());
+        for (i, g) in problem.goals.iter().enumerate() {
+            let path = p.path_to(i).unwrap();
+            assert_eq!(path[0], problem.start);
+            assert_eq!(*path.last().unwrap(), g.center, "goal {i} ends at its centre");
+        }
+        // Every goal tree joined the start tree: one tree over all vertices.
+        assert!(!is_cyclic_undirected(p.roadmap()));
+        assert_eq!(p.roadmap().edge_count(), p.roadmap().node_count() - 1);
+    }
+    // A goal inside the wall is invalid, whichever its position in the list.
+    let mut bad = problem.clone();
+    bad.goals[2] = goal(3.0, 3.0);
+    let mut p = RrtConnect::new(&map, space(0.5), 0);
+    assert_eq!(p.solve(&bad, &mut MaxIterations(10)), PlannerStatus::InvalidGoal);
+}
+
+#[test]
 fn determinism_counters_and_termination() {
     let counted = Counted::new(wall_with_door());
     let problem = across(0.0);
@@ -120,25 +146,34 @@ proptest! {
     fn every_edge_is_free_on_random_scenes(
         patches in strategies::scene(SceneKind::Mixed, 0..6),
         start in strategies::point3(strategies::scene_bounds()),
-        goal in strategies::point3(strategies::scene_bounds()),
+        goals in proptest::collection::vec(strategies::point3(strategies::scene_bounds()), 1..4),
         tolerance in 0.0..0.5f64,
         seed in any::<u64>(),
     ) {
         let map = BruteForceMap::from_patches(patches).unwrap();
         let space = PlanningSpace::new(strategies::scene_bounds(), RADIUS, 0.8).unwrap();
-        let problem = Problem { start, goals: vec![Goal { center: goal, tolerance }] };
+        let problem = Problem {
+            start,
+            goals: goals.iter().map(|&center| Goal { center, tolerance }).collect(),
+        };
         let mut p = RrtConnect::new(&map, space, seed);
         let status = p.solve(&problem, &mut MaxIterations(60));
-        assert_all_free(&map, &p, 1);
+        assert_all_free(&map, &p, goals.len());
         let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
         prop_assert_eq!(status == PlannerStatus::InvalidStart, !sphere_free(start));
         if sphere_free(start) {
-            prop_assert_eq!(status == PlannerStatus::InvalidGoal, !sphere_free(goal));
+            let all_free = goals.iter().all(|&g| sphere_free(g));
+            prop_assert_eq!(status == PlannerStatus::InvalidGoal, !all_free);
         }
-        prop_assert_eq!(status == PlannerStatus::Exact, p.path_to(0).is_some());
-        if let Some(path) = p.path_to(0) {
-            prop_assert_eq!(path[0], start);
-            prop_assert!((path.last().unwrap() - goal).norm() <= tolerance + 1e-12);
+        prop_assert_eq!(
+            status == PlannerStatus::Exact,
+            (0..goals.len()).all(|i| p.path_to(i).is_some())
+        );
+        for (i, goal) in goals.iter().enumerate() {
+            if let Some(path) = p.path_to(i) {
+                prop_assert_eq!(path[0], start);
+                prop_assert!((path.last().unwrap() - goal).norm() <= tolerance + 1e-12);
+            }
         }
         let graph = p.roadmap();
         prop_assert!(!is_cyclic_undirected(graph));
