@@ -8,9 +8,9 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, LazyPrm, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
-    MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
-    RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
+    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, LazyPrm, MaPrm, MaPrmConfig, MaRrt,
+    MaRrtConfig, MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt,
+    RrtConfig, RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ pub enum PlannerChoice {
     LazyPrm,
     /// RRT* (Karaman and Frazzoli 2011): ⌈2e ln n⌉ nearest candidates for parent and rewiring.
     RrtStar,
-    /// RRT-Connect (Kuffner and LaValle 2000), one goal.
+    /// RRT-Connect (Kuffner and LaValle 2000), one goal tree per goal joined to the start tree.
     RrtConnect,
     /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
     EvasionRrt,
@@ -37,6 +37,14 @@ pub enum PlannerChoice {
     MaPrm,
     /// Medial-axis RRT (thesis §5.5.2): needs a patch map (proximity queries).
     MaRrt,
+}
+
+impl PlannerChoice {
+    /// The name on the command line (`rrt`, `evasion-rrt`, ...), which is also the name the
+    /// planner reports.
+    pub fn cli_name(self) -> String {
+        self.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default()
+    }
 }
 
 /// Arguments of `patchnav plan`: either one run on a map file (`MAP --start --goal --radius`),
@@ -122,7 +130,7 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
             .map(|&center| Goal { center, tolerance: args.goal_tolerance })
             .collect(),
     };
-    let mut planner = make_planner(args.planner, &map, space, args.seed, problem.goals.len())?;
+    let mut planner = make_planner(args.planner, &map, space, args.seed)?;
     let spinner = progress.spinner("planning");
     let status = if args.explore {
         planner.solve(&problem, &mut MaxIterations(args.iterations))
@@ -214,7 +222,6 @@ pub(crate) fn make_planner(
     map: &AnyMap,
     space: PlanningSpace,
     seed: u64,
-    num_goals: usize,
 ) -> Result<Box<dyn Planner + '_>> {
     Ok(match choice {
         PlannerChoice::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
@@ -228,12 +235,7 @@ pub(crate) fn make_planner(
             let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
             Box::new(RrtStar::new(map, space, config, seed))
         }
-        PlannerChoice::RrtConnect => {
-            if num_goals > 1 {
-                bail!("rrt-connect plans to exactly one --goal");
-            }
-            Box::new(RrtConnect::new(map, space, seed))
-        }
+        PlannerChoice::RrtConnect => Box::new(RrtConnect::new(map, space, seed)),
         PlannerChoice::EvasionRrt => evasion_planner(map, space, seed)?,
         PlannerChoice::MaPrm | PlannerChoice::MaRrt => medial_planner(choice, map, space, seed)?,
     })
@@ -272,7 +274,8 @@ fn medial_planner(
         AnyMap::Trimesh(m) => make(choice, m, space, seed),
         AnyMap::Rapier(m) => make(choice, m, space, seed),
         other => bail!(
-            "{choice:?} needs a map that answers proximity queries; a `{}` map cannot",
+            "{} needs a map that answers proximity queries; a `{}` map cannot",
+            choice.cli_name(),
             other.backend()
         ),
     })

@@ -243,7 +243,7 @@ pub(crate) fn skipped_row(
     seed: u64,
     reason: &anyhow::Error,
 ) -> Value {
-    let mut row = row_head(p, &format!("{choice:?}"), backend, mode, seed);
+    let mut row = row_head(p, &choice.cli_name(), backend, mode, seed);
     row["skipped"] = json!(format!("{reason:#}"));
     row
 }
@@ -305,7 +305,7 @@ pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Re
     for &seed in &p.seeds {
         for (goal_index, goals) in &queries {
             let problem = p.query(goals);
-            let row = match make_planner(choice, &map, space, seed, goals.len()) {
+            let row = match make_planner(choice, &map, space, seed) {
                 Ok(mut planner) => {
                     let outcome = solve_timed(planner.as_mut(), &problem, args.mode, p.iterations);
                     let paths: Vec<Option<Vec<Point3>>> =

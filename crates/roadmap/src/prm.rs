@@ -117,7 +117,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> {
     fn name(&self) -> &'static str {
-        "prm"
+        if self.config.star { "prm-star" } else { "prm" }
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
@@ -213,7 +213,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> LazyPrm<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for LazyPrm<'_, M> {
     fn name(&self) -> &'static str {
-        "lazy-prm"
+        if self.config.star { "lazy-prm-star" } else { "lazy-prm" }
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

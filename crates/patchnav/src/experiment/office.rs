@@ -519,7 +519,7 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
     let patches = read_patches(&p)?;
     for choice in &args.planners {
         if !PLANNERS.iter().any(|r| r.choice == *choice) {
-            bail!("planner {choice:?} is not in the office experiment's list");
+            bail!("planner {} is not in the office experiment's list", choice.cli_name());
         }
     }
     let planners: Vec<&PlannerRow> = PLANNERS
@@ -547,7 +547,7 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
             let mut cannot = None;
             for seed in 0..args.seeds {
                 bar.inc(1);
-                let mut planner = match make_planner(row.choice, &map, space, seed, p.goals.len()) {
+                let mut planner = match make_planner(row.choice, &map, space, seed) {
                     Ok(planner) => planner,
                     Err(reason) => {
                         if let Some(out) = &mut jsonl {
