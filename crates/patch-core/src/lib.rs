@@ -117,6 +117,7 @@ pub mod conformance;
 mod counted;
 mod error;
 pub mod geometry;
+pub mod triangulate;
 mod patch;
 mod polygon;
 mod reference;

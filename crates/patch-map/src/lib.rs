@@ -75,7 +75,9 @@ pub mod point_cloud;
 pub mod polygon;
 pub mod rapier;
 pub mod sampling;
-pub mod triangulate;
+/// Constrained Delaunay triangulation of polygons with holes; it lives in `patch-core`, which
+/// patch extraction shares, and is re-exported here.
+pub use patch_core::triangulate;
 pub mod trimesh;
 
 pub use from_mesh::{MeshToPatchesConfig, MeshToPatchesStats, planar_patches_from_mesh};
