@@ -117,11 +117,11 @@ pub mod conformance;
 mod counted;
 mod error;
 pub mod geometry;
-pub mod triangulate;
 mod patch;
 mod polygon;
 mod reference;
 mod step;
+pub mod triangulate;
 
 pub use capability::{
     FromPatches, PatchId, PatchMap, PatchMapMut, Proximity, ProximityQuery,
@@ -132,6 +132,7 @@ pub use counted::{Counted, QueryCounts};
 pub use error::{MapError, PatchError, StepError};
 pub use patch::{
     MIN_TRIANGLE_AREA, Patch, PatchKind, PlanarPatch, Plane, PlaneCovariance, TrimeshPatch,
+    plane_frame,
 };
 pub use pointcloud::{Aabb, Isometry3, Point3, Real, Vector3};
 pub use polygon::{Bounds2, Polygon, Ring, RingId};

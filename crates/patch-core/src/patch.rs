@@ -34,6 +34,25 @@ impl fmt::Display for PatchKind {
     }
 }
 
+/// The frame of a planar patch on the plane through `origin` with normal `normal` (any length
+/// but zero): `z` = the unit normal, `x` = the world axis least aligned with the normal (the
+/// first of x, y, z on ties) made orthogonal to it, `y = z × x`, origin at `origin`. Every
+/// patch built from world coordinates here ([`PlanarPatch::from_world_polygon`], patches from
+/// meshes, extraction) uses this rule, so patches of one plane share their axes.
+pub fn plane_frame(normal: &Vector3, origin: &Point3) -> Isometry3 {
+    let normal = normal.normalize();
+    let axis = normal.iamin();
+    let mut x = Vector3::zeros();
+    x[axis] = 1.0;
+    let x = (x - normal * normal[axis]).normalize();
+    let y = normal.cross(&x);
+    let rotation = na::Rotation3::from_matrix_unchecked(na::Matrix3::from_columns(&[x, y, normal]));
+    Isometry3::from_parts(
+        na::Translation3::from(origin.coords),
+        na::UnitQuaternion::from_rotation_matrix(&rotation),
+    )
+}
+
 /// A plane `normal · x = offset` in Hessian normal form.
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plane {
@@ -251,18 +270,7 @@ impl PlanarPatch {
         if newell.dot(&normal) < 0.0 {
             normal = -normal;
         }
-        let normal = normal.normalize();
-        let axis = normal.iamin();
-        let mut x = Vector3::zeros();
-        x[axis] = 1.0;
-        let x = (x - normal * normal[axis]).normalize();
-        let y = normal.cross(&x);
-        let rotation =
-            na::Rotation3::from_matrix_unchecked(na::Matrix3::from_columns(&[x, y, normal]));
-        let world_from_patch = Isometry3::from_parts(
-            na::Translation3::from(centroid.coords),
-            na::UnitQuaternion::from_rotation_matrix(&rotation),
-        );
+        let world_from_patch = plane_frame(&normal, &centroid);
         let mut local_rings = Vec::with_capacity(rings.len());
         for (ring, points) in &rings {
             let mut local = Vec::with_capacity(points.len());

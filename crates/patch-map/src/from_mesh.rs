@@ -21,7 +21,8 @@
 
 use geo::{Contains, Coord, LineString, MultiPolygon, Polygon as GeoPolygon, unary_union};
 use patch_core::{
-    Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch, Vector3, na,
+    Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch, Vector3,
+    plane_frame,
 };
 use pointcloud::PolygonMesh;
 
@@ -70,16 +71,8 @@ struct Cluster {
 
 impl Cluster {
     fn new(tri: [Point3; 3], normal: Vector3) -> Cluster {
-        // Frame as `PlanarPatch::from_world_polygon` builds it: x = the world axis least
-        // aligned with the normal, made orthogonal to it; y = z × x; origin on the plane.
-        let axis = (0..3).min_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs())).unwrap_or(0);
-        let x = (Vector3::ith(axis, 1.0) - normal * normal[axis]).normalize();
-        let y = normal.cross(&x);
-        let rotation = na::Rotation3::from_basis_unchecked(&[x, y, normal]);
-        let world_from_plane = Isometry3::from_parts(
-            tri[0].coords.into(),
-            na::UnitQuaternion::from_rotation_matrix(&rotation),
-        );
+        // The frame every patch of this plane gets (`patch_core::plane_frame`).
+        let world_from_plane = plane_frame(&normal, &tri[0]);
         Cluster {
             world_from_plane,
             normal,
