@@ -271,7 +271,7 @@ fn unite<'a>(group: impl Iterator<Item = &'a PlanarPatch> + Clone) -> Option<Vec
         centre += centroid(p).coords * area;
         total += area;
     }
-    if !(total > 0.0) || normal.norm() == 0.0 {
+    if total.is_nan() || total <= 0.0 || normal.norm() == 0.0 {
         return None;
     }
     let frame = plane_frame(&normal, &Point3::from(centre / total));
