@@ -74,17 +74,20 @@ fn lab_timing_writes_a_row_per_checkpoint_and_a_plot_per_map() {
     }
     assert!(text.contains("| 50 |"), "the row for K = 50:\n{text}");
     assert!(text.contains("trimesh/planes") && text.contains("pc/planes"), "{text}");
+    assert!(text.contains("time per vertex at K = 50"), "{text}");
 
     let csv = std::fs::read_to_string(dir.path().join("lab-timing.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("map,start,seed,iterations,seconds"));
-    // Per run: (iterations, seconds) in order.
-    let mut runs: BTreeMap<(String, u32, u64), Vec<(u64, f64)>> = BTreeMap::new();
+    assert_eq!(lines.next(), Some("map,start,seed,iterations,seconds,vertices"));
+    // Per run (map, start, seed): (iterations, seconds, vertices) in order.
+    type Checkpoint = (u64, f64, usize);
+    let mut runs: BTreeMap<(String, u32, u64), Vec<Checkpoint>> = BTreeMap::new();
     for line in lines {
         let f: Vec<&str> = line.split(',').collect();
-        assert_eq!(f.len(), 5, "{line}");
+        assert_eq!(f.len(), 6, "{line}");
         let key = (f[0].to_owned(), f[1].parse().unwrap(), f[2].parse().unwrap());
-        runs.entry(key).or_default().push((f[3].parse().unwrap(), f[4].parse().unwrap()));
+        let row = (f[3].parse().unwrap(), f[4].parse().unwrap(), f[5].parse().unwrap());
+        runs.entry(key).or_default().push(row);
     }
     // 4 maps × 1 start × 2 seeds, checkpoints every 10 iterations to 50.
     assert_eq!(runs.len(), 8, "{:?}", runs.keys());
@@ -95,6 +98,9 @@ fn lab_timing_writes_a_row_per_checkpoint_and_a_plot_per_map() {
             assert_eq!(iterations, [10, 20, 30, 40, 50], "{map} seed {seed}");
             assert!(run.iter().all(|r| r.1 > 0.0 && r.1.is_finite()));
             assert!(run.windows(2).all(|w| w[0].1 <= w[1].1), "times grow: {run:?}");
+            // An RRT adds at most one vertex per iteration, to the start's one.
+            assert!(run.windows(2).all(|w| w[0].2 <= w[1].2), "vertices grow: {run:?}");
+            assert!(run.iter().all(|r| r.2 >= 1 && r.2 as u64 <= r.0 + 1), "{run:?}");
         }
     }
 

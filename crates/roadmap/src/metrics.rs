@@ -65,19 +65,26 @@ pub fn turn_angles(path: &[Point3]) -> Vec<Real> {
     directions.windows(2).map(|d| d[0].cross(&d[1]).norm().atan2(d[0].dot(&d[1]))).collect()
 }
 
-/// The upper quartile of `values` by linear interpolation between closest ranks (type 7):
-/// `h = 0.75 (n − 1)`, `Q3 = x_⌊h⌋ + (h − ⌊h⌋)(x_⌊h⌋+1 − x_⌊h⌋)` over the sorted values.
-/// `None` for no values. NaNs sort last (total order).
-pub fn upper_quartile(values: &[Real]) -> Option<Real> {
-    if values.is_empty() {
+/// The `p`-quantile (`0 ≤ p ≤ 1`) of `values` by linear interpolation between closest ranks
+/// (Hyndman & Fan type 7, R's default): over the sorted values, `h = p (n − 1)`,
+/// `Q = x_⌊h⌋ + (h − ⌊h⌋)(x_⌊h⌋+1 − x_⌊h⌋)`. `None` for no values or a `p` outside `[0, 1]`.
+/// NaNs sort last (total order). The experiments report every median and quartile with it.
+pub fn quantile(values: &[Real], p: Real) -> Option<Real> {
+    if values.is_empty() || !(0.0..=1.0).contains(&p) {
         return None;
     }
     let mut sorted = values.to_vec();
     sorted.sort_by(Real::total_cmp);
-    let h = 0.75 * (sorted.len() - 1) as Real;
+    let h = p * (sorted.len() - 1) as Real;
     let lo = h.floor() as usize;
     let hi = (lo + 1).min(sorted.len() - 1);
     Some(sorted[lo] + (h - lo as Real) * (sorted[hi] - sorted[lo]))
+}
+
+/// The upper quartile of `values` ([`quantile`] at 0.75, type 7): the thesis's curviness is
+/// the upper quartile of the turn angles. `None` for no values.
+pub fn upper_quartile(values: &[Real]) -> Option<Real> {
+    quantile(values, 0.75)
 }
 
 /// The thesis's "summed path length to all ROIs" (Table 5.5): the sum of the lengths of the

@@ -50,6 +50,7 @@ use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
 use patch_map::AnyMap;
 use pointcloud::Aabb;
+use roadmap::metrics::quantile;
 use roadmap::volume::{CongruenceTable, VoxelGrid};
 use roadmap::{
     MaxIterations, Planner as _, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Roadmap,
@@ -337,11 +338,17 @@ fn table_6_1(lab: &Lab, args: &LabMapArgs) -> Result<String> {
 struct CheckpointTimer {
     checkpoints: Vec<u64>,
     seconds: Vec<f64>,
+    /// Roadmap vertices at each checkpoint (for the time per vertex).
+    vertices: Vec<usize>,
 }
 
 impl CheckpointTimer {
     fn new(checkpoints: Vec<u64>) -> CheckpointTimer {
-        CheckpointTimer { seconds: Vec::with_capacity(checkpoints.len()), checkpoints }
+        CheckpointTimer {
+            seconds: Vec::with_capacity(checkpoints.len()),
+            vertices: Vec::with_capacity(checkpoints.len()),
+            checkpoints,
+        }
     }
 }
 
@@ -352,6 +359,7 @@ impl Termination for CheckpointTimer {
                 break;
             }
             self.seconds.push(progress.elapsed.as_secs_f64());
+            self.vertices.push(progress.vertices);
         }
         self.seconds.len() == self.checkpoints.len()
     }
@@ -376,23 +384,15 @@ struct TimedRun {
     seed: u64,
     /// Seconds at each checkpoint.
     seconds: Vec<f64>,
-}
-
-/// Quartiles by linear interpolation between order statistics (R's type 7).
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let h = (sorted.len() - 1) as f64 * q;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+    /// Roadmap vertices at each checkpoint.
+    vertices: Vec<usize>,
 }
 
 /// (lower quartile, median, upper quartile) of the runs of `map` at checkpoint `c`.
 fn quartiles(runs: &[TimedRun], map: MapKind, c: usize) -> (f64, f64, f64) {
-    let mut v: Vec<f64> = runs.iter().filter(|r| r.map == map).map(|r| r.seconds[c]).collect();
-    v.sort_by(f64::total_cmp);
-    (quantile(&v, 0.25), quantile(&v, 0.5), quantile(&v, 0.75))
+    let v: Vec<f64> = runs.iter().filter(|r| r.map == map).map(|r| r.seconds[c]).collect();
+    let q = |p| quantile(&v, p).unwrap_or(f64::NAN);
+    (q(0.25), q(0.5), q(0.75))
 }
 
 /// Runs `patchnav experiment lab-timing`.
@@ -421,7 +421,13 @@ pub fn run_timing(args: &LabTimingArgs, progress: &Progress) -> Result<()> {
                 if timer.seconds.len() != cps.len() {
                     bail!("the {} run (start {s}, seed {seed}) stopped early", map.kind);
                 }
-                runs.push(TimedRun { map: map.kind, start: s, seed, seconds: timer.seconds });
+                runs.push(TimedRun {
+                    map: map.kind,
+                    start: s,
+                    seed,
+                    seconds: timer.seconds,
+                    vertices: timer.vertices,
+                });
                 bar.inc(1);
             }
         }
@@ -444,10 +450,10 @@ pub fn run_timing(args: &LabTimingArgs, progress: &Progress) -> Result<()> {
 }
 
 fn timing_csv(runs: &[TimedRun], cps: &[u64]) -> String {
-    let mut out = String::from("map,start,seed,iterations,seconds\n");
+    let mut out = String::from("map,start,seed,iterations,seconds,vertices\n");
     for r in runs {
-        for (k, s) in cps.iter().zip(&r.seconds) {
-            let _ = writeln!(out, "{},{},{},{k},{s:.9}", r.map, r.start, r.seed);
+        for ((k, s), v) in cps.iter().zip(&r.seconds).zip(&r.vertices) {
+            let _ = writeln!(out, "{},{},{},{k},{s:.9},{v}", r.map, r.start, r.seed);
         }
     }
     out
@@ -501,6 +507,18 @@ fn timing_table(
         }
         writeln!(out, "{line}")?;
     }
+    // The thesis's other timing figure of merit (§6.2.3, Fig 6.12): time per roadmap vertex.
+    let last = cps.len() - 1;
+    write!(out, "time per vertex at K = {} [µs], median:", cps[last])?;
+    for &k in kinds {
+        let v: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.map == k && r.vertices[last] > 0)
+            .map(|r| r.seconds[last] / r.vertices[last] as f64 * 1e6)
+            .collect();
+        write!(out, " {k} {}", sig(quantile(&v, 0.5).unwrap_or(f64::NAN)))?;
+    }
+    writeln!(out)?;
     writeln!(out, "{THESIS_FIG_6_4}")?;
     Ok(out)
 }
@@ -782,10 +800,6 @@ mod tests {
 
     #[test]
     fn quartiles_interpolate() {
-        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
-        assert_eq!(quantile(&v, 0.5), 3.0);
-        assert_eq!(quantile(&v, 0.25), 2.0);
-        assert_eq!(quantile(&[1.0, 2.0], 0.5), 1.5);
         assert_eq!(sig(0.012345), "0.0123");
         assert_eq!(sig(4.5678), "4.57");
         assert_eq!(sig(0.0), "0.0");

@@ -26,9 +26,8 @@
 //!
 //! # Statistics
 //! Medians and quartiles over the successful runs of a cell by linear interpolation between
-//! closest ranks (Hyndman & Fan type 7, the method of `roadmap::metrics::upper_quartile`;
-//! written here as [`quantile`] because roadmap exports only the upper quartile). Quartiles
-//! are printed as ratios to the median (Tables 5.4, 5.6, 5.11). In Tables 5.7–5.9 the ratio is
+//! closest ranks (Hyndman & Fan type 7, [`roadmap::metrics::quantile`], the method of the
+//! curviness). Quartiles are printed as ratios to the median (Tables 5.4, 5.6, 5.11). In Tables 5.7–5.9 the ratio is
 //! the quantile of steep turns over the quantile of total turns, as the thesis's numbers show
 //! (3/20 = .150, 22/91 = .242); 0 where there are no turns at all.
 //!
@@ -48,7 +47,7 @@ use ProblemBackend as B;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{Point3, Real};
-use roadmap::metrics::{added_length, turn_angles, upper_quartile};
+use roadmap::metrics::{added_length, quantile, turn_angles, upper_quartile};
 use roadmap::{PathMetrics, Planner};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -236,21 +235,6 @@ struct Results<'a> {
     planners: Vec<&'a PlannerRow>,
     backends: Vec<&'a (ProblemBackend, &'static str, &'static str)>,
     cells: Vec<Vec<Cell>>,
-}
-
-/// The `p`-quantile (`0 ≤ p ≤ 1`) of `values` by linear interpolation between closest ranks
-/// (Hyndman & Fan type 7, the method of `roadmap::metrics::upper_quartile`): over the sorted
-/// values, `h = p (n − 1)`, `x_⌊h⌋ + (h − ⌊h⌋)(x_⌊h⌋+1 − x_⌊h⌋)`. `None` for no values.
-fn quantile(values: &[Real], p: Real) -> Option<Real> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut sorted = values.to_vec();
-    sorted.sort_by(Real::total_cmp);
-    let h = p * (sorted.len() - 1) as Real;
-    let lo = h.floor() as usize;
-    let hi = (lo + 1).min(sorted.len() - 1);
-    Some(sorted[lo] + (h - lo as Real) * (sorted[hi] - sorted[lo]))
 }
 
 /// Lower quartile, median, upper quartile.
@@ -1124,16 +1108,6 @@ fn claims(r: &Results<'_>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn quantile_is_type_7_and_agrees_with_the_metrics_module() {
-        assert_eq!(quantile(&[], 0.5), None);
-        assert_eq!(quantile(&[4.0, 1.0, 3.0, 2.0], 0.5), Some(2.5));
-        assert_eq!(quantile(&[4.0, 1.0, 3.0, 2.0], 0.25), Some(1.75));
-        for values in [&[3.0][..], &[5.0, 1.0, 4.0, 2.0, 3.0], &[0.3, 0.1, 2.0, 7.5, 1.0, 1.0]] {
-            assert_eq!(quantile(values, 0.75), upper_quartile(values));
-        }
-    }
 
     #[test]
     fn numbers_print_as_in_the_thesis() {
