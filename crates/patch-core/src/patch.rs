@@ -596,7 +596,50 @@ impl From<TrimeshPatch> for Patch {
     }
 }
 
+impl PlanarPatch {
+    /// This patch moved rigidly by `motion` (e.g. from a scan's sensor frame to the world by
+    /// the scan's pose): the frame becomes `motion · world_from_patch`, and a plane covariance
+    /// of `(n, d)` is carried along to first order — exactly, since the map is linear:
+    /// `n' = R n`, `d' = d + n'·t`, so `Σ' = J Σ Jᵀ` with `J = [[R, 0], [(Rᵀ t)ᵀ, 1]]`.
+    pub fn transformed(&self, motion: &Isometry3) -> PlanarPatch {
+        let world_from_patch = motion * self.world_from_patch;
+        let covariance = self.covariance.map(|c| {
+            let r = motion.rotation.to_rotation_matrix().into_inner();
+            let rt_t = r.transpose() * motion.translation.vector;
+            let mut j = na::Matrix4::<Real>::zeros();
+            j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+            j[(3, 0)] = rt_t.x;
+            j[(3, 1)] = rt_t.y;
+            j[(3, 2)] = rt_t.z;
+            j[(3, 3)] = 1.0;
+            let m = j * c.matrix() * j.transpose();
+            // Symmetric up to rounding; re-symmetrise exactly.
+            PlaneCovariance((m + m.transpose()) * 0.5)
+        });
+        PlanarPatch { polygon: self.polygon.clone(), world_from_patch, covariance }
+    }
+}
+
+impl TrimeshPatch {
+    /// This mesh moved rigidly by `motion`.
+    pub fn transformed(&self, motion: &Isometry3) -> TrimeshPatch {
+        TrimeshPatch {
+            vertices: self.vertices.iter().map(|v| motion * v).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
 impl Patch {
+    /// This patch moved rigidly by `motion` ([`PlanarPatch::transformed`],
+    /// [`TrimeshPatch::transformed`]).
+    pub fn transformed(&self, motion: &Isometry3) -> Patch {
+        match self {
+            Patch::Planar(p) => Patch::Planar(p.transformed(motion)),
+            Patch::Trimesh(m) => Patch::Trimesh(m.transformed(motion)),
+        }
+    }
+
     /// The heap bytes this patch owns (its polygon rings or mesh buffers, by capacity); the
     /// patch value itself is not included.
     pub fn heap_bytes(&self) -> usize {

@@ -274,3 +274,54 @@ fn serde_round_trips_and_revalidates() {
     let empty = r#"{"trimesh":{"vertices":[],"triangles":[]}}"#;
     assert!(serde_json::from_str::<Patch>(empty).is_err());
 }
+
+#[test]
+fn rigid_motion_moves_geometry_and_covariance() {
+    let motion = Isometry3::from_parts(
+        na::Translation3::new(1.0, -2.0, 0.5),
+        na::UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1),
+    );
+    let cov = na::Matrix4::from_fn(|r, c| if r == c { 0.01 * (r + 1) as Real } else { 0.001 });
+    let patch = PlanarPatch::rectangle(tilted(), Point2::new(0.2, 0.3), Point2::new(2.2, 1.3))
+        .unwrap()
+        .with_covariance(PlaneCovariance::new(cov).unwrap());
+    let moved = patch.transformed(&motion);
+    assert!((moved.area() - patch.area()).abs() < 1e-12);
+    let q = Point3::new(0.7, 0.1, 3.0);
+    let d0 = patch.closest_point(&q).distance;
+    let d1 = moved.closest_point(&(motion * q)).distance;
+    assert!((d0 - d1).abs() < 1e-12, "{d0} vs {d1}");
+    // The plane parameters move linearly: (n + δn, d + δd) maps to (n', d') + J (δn, δd).
+    let plane_of = |n: Vector3, d: Real| {
+        let n2 = motion.rotation * n;
+        (n2, d + n2.dot(&motion.translation.vector))
+    };
+    let (n, d) = (patch.normal().into_inner(), patch.offset());
+    let (n1, d1) = plane_of(n, d);
+    assert!(
+        (moved.normal().into_inner() - n1).norm() < 1e-12 && (moved.offset() - d1).abs() < 1e-12
+    );
+    let j = {
+        let r = motion.rotation.to_rotation_matrix().into_inner();
+        let t = r.transpose() * motion.translation.vector;
+        let mut j = na::Matrix4::<Real>::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+        j[(3, 0)] = t.x;
+        j[(3, 1)] = t.y;
+        j[(3, 2)] = t.z;
+        j[(3, 3)] = 1.0;
+        j
+    };
+    let delta = na::Vector4::new(1e-3, -2e-3, 0.5e-3, 0.01);
+    let (n2, d2) = plane_of(n + delta.fixed_rows::<3>(0), d + delta[3]);
+    let lin = j * delta;
+    assert!((n2 - n1 - lin.fixed_rows::<3>(0)).norm() < 1e-12 && (d2 - d1 - lin[3]).abs() < 1e-12);
+    let expected = j * cov * j.transpose();
+    assert!((moved.covariance().unwrap().matrix() - expected).norm() < 1e-12);
+    // A mesh keeps its triangles and moves its vertices.
+    let m = mesh();
+    let mm = Patch::from(m.clone()).transformed(&motion);
+    let mm = mm.as_trimesh().unwrap();
+    assert_eq!(mm.triangles(), m.triangles());
+    assert!(mm.vertices().iter().zip(m.vertices()).all(|(a, b)| (a - motion * b).norm() < 1e-12));
+}
