@@ -1,0 +1,420 @@
+//! Plane segmentation of simulated scans and synthetic clouds, scored with SegComp.
+
+use patch_core::{Plane, Point3, Real, UnitVector3, Vector3};
+use patch_extract::Segmentation;
+use patch_extract::evaluate::{SegCompConfig, SegCompReport, segcomp};
+use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
+use patch_extract::segment::{SegmentConfig, SegmentError, segment, segment_unorganised};
+use pointcloud::{BeamModel, PointCloud, SensorPose};
+use scene_sim::{
+    Alrf, AlrfConfig, Cuboid, Material, PlanarPolygon, RangeCamera, RangeCameraConfig, RangeSensor,
+    Scene, SceneBuilder, SimulatedScan, SurfaceId, camera_pose_looking,
+};
+use std::time::Instant;
+
+/// A room corner: floor, two walls, a box on the floor and a tilted board.
+fn corner_scene() -> Scene {
+    let mut b = SceneBuilder::new("corner");
+    let floor = PlanarPolygon::parallelogram(
+        Point3::new(-1.0, -4.0, 0.0),
+        Vector3::new(7.0, 0.0, 0.0),
+        Vector3::new(0.0, 8.0, 0.0),
+    )
+    .unwrap();
+    let back = PlanarPolygon::parallelogram(
+        Point3::new(5.0, 4.0, 0.0),
+        Vector3::new(0.0, -8.0, 0.0),
+        Vector3::new(0.0, 0.0, 3.0),
+    )
+    .unwrap();
+    let side = PlanarPolygon::parallelogram(
+        Point3::new(-1.0, 2.5, 0.0),
+        Vector3::new(6.0, 0.0, 0.0),
+        Vector3::new(0.0, 0.0, 3.0),
+    )
+    .unwrap();
+    let board = PlanarPolygon::parallelogram(
+        Point3::new(2.5, -2.2, 0.0),
+        Vector3::new(0.0, 1.2, 0.0),
+        Vector3::new(0.6, 0.0, 1.0),
+    )
+    .unwrap();
+    let cube =
+        Cuboid::axis_aligned(Point3::new(2.8, 0.3, 0.0), Point3::new(3.6, 1.3, 0.7)).unwrap();
+    b.add("floor", floor, Material::CONCRETE).unwrap();
+    b.add("back", back, Material::WHITE_MASONRY).unwrap();
+    b.add("side", side, Material::WHITE_MASONRY).unwrap();
+    b.add("board", board, Material::WOOD).unwrap();
+    b.add("cube", cube, Material::WOOD).unwrap();
+    b.build().unwrap()
+}
+
+fn camera(sigma: Real) -> RangeCamera {
+    RangeCamera::new(RangeCameraConfig {
+        range_sigma: sigma,
+        ..RangeCameraConfig::swissranger_sr3000()
+    })
+    .unwrap()
+}
+
+fn alrf(step_deg: Real, sigma: Real, mixed: bool) -> Alrf {
+    let mut config = AlrfConfig::sick_s300_with_step(step_deg.to_radians()).unwrap();
+    config.range_sigma = sigma;
+    if !mixed {
+        config.mixed_pixels = None;
+    }
+    Alrf::new(config).unwrap()
+}
+
+fn camera_pose() -> SensorPose {
+    camera_pose_looking(Point3::new(0.0, 0.0, 1.3), 0.1, -0.3)
+}
+
+/// The true plane of `surface` in the sensor frame of `pose`.
+fn plane_in_sensor(scene: &Scene, pose: &SensorPose, surface: u32) -> Option<Plane> {
+    let plane = scene.surface(SurfaceId(surface))?.plane?;
+    let m = &pose.world_from_sensor;
+    let normal = UnitVector3::new_normalize(m.rotation.inverse() * plane.normal.into_inner());
+    let offset = plane.offset - plane.normal.dot(&m.translation.vector);
+    Some(Plane { normal, offset })
+}
+
+/// Checks the segmentation invariants: disjoint ascending regions, largest first, the
+/// remainder the rest, planes facing the sensor.
+fn check_invariants(cloud: &PointCloud, seg: &Segmentation, min_size: usize) {
+    let mut seen = vec![false; cloud.len()];
+    for w in seg.regions.windows(2) {
+        assert!(w[0].points.len() >= w[1].points.len());
+    }
+    for r in &seg.regions {
+        assert!(r.points.len() >= min_size);
+        assert!(r.points.windows(2).all(|w| w[0] < w[1]));
+        assert!(r.plane.normal.dot(&(Point3::origin() - r.centroid)) >= 0.0);
+        assert!(r.covariance.is_some());
+        for &i in &r.points {
+            assert!(!std::mem::replace(&mut seen[i as usize], true));
+        }
+    }
+    assert!(seg.remainder.windows(2).all(|w| w[0] < w[1]));
+    for &i in &seg.remainder {
+        assert!(!std::mem::replace(&mut seen[i as usize], true));
+    }
+    assert!(seen.iter().all(|&s| s), "every point is in a region or the remainder");
+}
+
+fn evaluate(
+    scene: &Scene,
+    scan: &SimulatedScan,
+    cloud: &PointCloud,
+    seg: &Segmentation,
+    min_truth: usize,
+) -> SegCompReport {
+    let report = segcomp(cloud.labels().unwrap(), seg, &SegCompConfig::hoover(min_truth), |l| {
+        plane_in_sensor(scene, &scan.pose, l)
+    })
+    .unwrap();
+    println!("{report}");
+    report
+}
+
+#[test]
+fn range_camera_noise_free_detects_every_large_surface() {
+    let scene = corner_scene();
+    let scan = camera(0.0).scan(&scene, &camera_pose(), 1);
+    let cloud = scan.to_cloud().unwrap();
+    let config = SegmentConfig::exact();
+    let seg = segment(&cloud, &config).unwrap();
+    check_invariants(&cloud, &seg, config.min_region_size);
+    let report = evaluate(&scene, &scan, &cloud, &seg, 200);
+    assert!(report.num_truth >= 5, "{report}");
+    assert_eq!(report.correct.len(), report.num_truth, "{report}");
+    assert!(report.max_angle_error_deg().unwrap() < 0.5, "{report}");
+}
+
+#[test]
+fn range_camera_default_noise_detects_most_surfaces() {
+    let scene = corner_scene();
+    let scan = camera(0.01).scan(&scene, &camera_pose(), 2);
+    let cloud = scan.to_cloud().unwrap();
+    let config = SegmentConfig::range_camera();
+    let seg = segment(&cloud, &config).unwrap();
+    check_invariants(&cloud, &seg, config.min_region_size);
+    let report = evaluate(&scene, &scan, &cloud, &seg, 200);
+    assert!(report.correct_ratio() >= 0.8, "{report}");
+    assert!(report.under.is_empty(), "{report}");
+    assert!(report.mean_angle_error_deg().unwrap() < 2.0, "{report}");
+}
+
+#[test]
+fn range_camera_unorganised_matches_organised_when_noise_free() {
+    let scene = corner_scene();
+    let scan = camera(0.0).scan(&scene, &camera_pose(), 3);
+    let cloud = scan.to_cloud().unwrap();
+    let config = SegmentConfig { knn_radius: 0.15, ..SegmentConfig::exact() };
+    let seg = segment_unorganised(&cloud, &config).unwrap();
+    check_invariants(&cloud, &seg, config.min_region_size);
+    let report = evaluate(&scene, &scan, &cloud, &seg, 200);
+    assert_eq!(report.correct.len(), report.num_truth, "{report}");
+    assert!(report.max_angle_error_deg().unwrap() < 0.5, "{report}");
+}
+
+fn alrf_scan(sigma: Real, mixed: bool) -> (Scene, SimulatedScan, PointCloud) {
+    let scene = corner_scene();
+    let sensor = alrf(1.0, sigma, mixed);
+    let pose = SensorPose::from_position_rpy(Point3::new(0.0, 0.0, 0.8), 0.0, 0.0, 0.2);
+    let scan = sensor.scan(&scene, &pose, 4);
+    let cloud = scan.to_cloud().unwrap();
+    let BeamModel::ActuatedLrf(model) = sensor.beam_model() else { unreachable!() };
+    let (cloud, _) =
+        invalidate_alrf_side_columns(&cloud, &model, &AlrfSideColumns::thesis()).unwrap();
+    (scene, scan, cloud)
+}
+
+#[test]
+fn alrf_noise_free_detects_every_large_surface() {
+    let (scene, scan, cloud) = alrf_scan(0.0, false);
+    let config = SegmentConfig { min_region_size: 30, ..SegmentConfig::exact() };
+    let seg = segment(&cloud, &config).unwrap();
+    check_invariants(&cloud, &seg, config.min_region_size);
+    let report = evaluate(&scene, &scan, &cloud, &seg, 100);
+    assert!(report.num_truth >= 4, "{report}");
+    assert!(report.missed.is_empty() && report.under.is_empty(), "{report}");
+    assert!(report.correct.len() + report.over.len() == report.num_truth, "{report}");
+    assert!(report.correct_ratio() >= 0.75, "{report}");
+    assert!(report.max_angle_error_deg().unwrap() < 0.5, "{report}");
+}
+
+#[test]
+fn alrf_default_noise_detects_most_surfaces() {
+    let (scene, scan, cloud) = alrf_scan(0.03, true);
+    let config = SegmentConfig { min_region_size: 30, ..SegmentConfig::alrf() };
+    let seg = segment(&cloud, &config).unwrap();
+    check_invariants(&cloud, &seg, config.min_region_size);
+    let report = evaluate(&scene, &scan, &cloud, &seg, 100);
+    assert!(report.correct_ratio() >= 0.75, "{report}");
+    assert!(report.under.is_empty() && report.missed.is_empty(), "{report}");
+    assert!(report.mean_angle_error_deg().unwrap() < 3.0, "{report}");
+}
+
+/// An organised `w × h` cloud of two planes meeting at a ridge at `x = 0` (a roof seen from
+/// below: z = 3 − 0.8 |x|).
+fn ridge_cloud(w: u32, h: u32) -> PointCloud {
+    let pixels = (0..h).flat_map(|row| {
+        (0..w).map(move |col| {
+            let x = -1.0 + 2.0 * col as Real / (w - 1) as Real;
+            let y = -0.6 + 1.2 * row as Real / (h - 1) as Real;
+            Some(Point3::new(x, y, 3.0 - 0.8 * x.abs()))
+        })
+    });
+    PointCloud::from_pixels(w, h, pixels).unwrap()
+}
+
+#[test]
+fn two_planes_meeting_at_an_edge_give_two_regions() {
+    let cloud = ridge_cloud(61, 40);
+    for seg in [
+        segment(&cloud, &SegmentConfig::exact()).unwrap(),
+        segment_unorganised(&cloud, &SegmentConfig::exact()).unwrap(),
+    ] {
+        check_invariants(&cloud, &seg, 50);
+        assert_eq!(seg.regions.len(), 2);
+        for r in &seg.regions {
+            // Each side has 30 columns of its own, the ridge column goes to either.
+            assert!((30 * 40..=31 * 40).contains(&r.points.len()), "{}", r.points.len());
+            assert!(r.mse < 1e-12);
+            let slope = r.plane.normal.x.abs() / r.plane.normal.z.abs();
+            assert!((slope - 0.8).abs() < 1e-6);
+            assert!(r.plane.normal.z < 0.0, "faces the sensor at the origin");
+        }
+        assert!(seg.remainder.len() <= 40);
+    }
+}
+
+/// A tiny deterministic generator (SplitMix64) for random clouds.
+fn uniform(state: &mut u64) -> Real {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) as Real / u64::MAX as Real
+}
+
+#[test]
+fn random_points_give_no_large_regions() {
+    let mut state = 42;
+    let (w, h) = (60u32, 50u32);
+    let pixels: Vec<Option<Point3>> = (0..w * h)
+        .map(|_| {
+            let x = uniform(&mut state) - 0.5;
+            let y = uniform(&mut state) - 0.5;
+            Some(Point3::new(x, y, 2.0 + uniform(&mut state)))
+        })
+        .collect();
+    let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+    // Organised: pixel neighbours are unrelated points, nothing links.
+    for config in [SegmentConfig::range_camera(), SegmentConfig::alrf()] {
+        let seg = segment(&cloud, &config).unwrap();
+        check_invariants(&cloud, &seg, config.min_region_size);
+        assert!(seg.regions.is_empty(), "{} regions", seg.regions.len());
+        assert_eq!(seg.remainder.len(), cloud.len());
+    }
+    // Unorganised at 1 cm noise: no slab of the cloud is thin enough to pass.
+    let seg = segment_unorganised(&cloud, &SegmentConfig::range_camera()).unwrap();
+    assert!(seg.regions.is_empty(), "{} regions", seg.regions.len());
+    // At the scanner's 3 cm noise a ±3.6 cm slab of this dense cloud (3000 points per m³)
+    // holds ~200 points and is a plane within that noise: regions appear, but none is large.
+    let seg = segment_unorganised(&cloud, &SegmentConfig::alrf()).unwrap();
+    check_invariants(&cloud, &seg, SegmentConfig::alrf().min_region_size);
+    assert!(seg.regions.iter().all(|r| r.points.len() < cloud.len() / 5));
+}
+
+#[test]
+fn bad_configs_are_errors() {
+    let cloud = ridge_cloud(10, 10);
+    let base = SegmentConfig::exact();
+    let mut nan = base;
+    nan.noise.sigma_0 = Real::NAN;
+    let mut negative = base;
+    negative.distance_factor = -1.0;
+    let mut jump = base;
+    jump.jump_relative = Real::INFINITY;
+    for bad in [nan, negative, jump] {
+        assert!(matches!(segment(&cloud, &bad), Err(SegmentError::BadParameter { .. })));
+        assert!(bad.validate().is_err());
+    }
+    let zero_min = SegmentConfig { min_region_size: 0, ..base };
+    assert_eq!(
+        segment(&cloud, &zero_min),
+        Err(SegmentError::TooSmall { name: "min_region_size", value: 0, min: 4 })
+    );
+    let zero_k = SegmentConfig { knn: 0, ..base };
+    assert!(segment_unorganised(&cloud, &zero_k).is_err());
+    let zero_seed = SegmentConfig { seed_radius: 0, ..base };
+    assert!(segment(&PointCloud::new(), &zero_seed).is_err(), "checked before the input");
+    let msg = segment(&cloud, &negative).unwrap_err().to_string();
+    assert!(msg.contains("distance_factor"), "{msg}");
+}
+
+#[test]
+fn empty_clouds_give_empty_segmentations() {
+    let config = SegmentConfig::alrf();
+    assert_eq!(segment(&PointCloud::new(), &config).unwrap(), Segmentation::default());
+    assert_eq!(segment_unorganised(&PointCloud::new(), &config).unwrap(), Segmentation::default());
+    let all_invalid = PointCloud::from_pixels(4, 3, vec![None; 12]).unwrap();
+    assert_eq!(segment(&all_invalid, &config).unwrap(), Segmentation::default());
+    // A handful of points: no region, everything remainder.
+    let few = ridge_cloud(3, 2);
+    let seg = segment(&few, &SegmentConfig::exact()).unwrap();
+    assert!(seg.regions.is_empty());
+    assert_eq!(seg.remainder, (0..6).collect::<Vec<u32>>());
+}
+
+/// Release-mode measurements for the report, on three poses in the lab:
+/// `cargo test --release -p patch-extract --test segment -- --ignored --nocapture`.
+#[test]
+#[ignore = "measurement; run in release"]
+fn measure_lab_scans() {
+    let scene = scene_sim::scene_by_name("lab", 7).unwrap();
+    let bodies = scene.scan_poses(3, 0.8, 7);
+    let runs: [(&str, Box<dyn RangeSensor>, SegmentConfig); 6] = [
+        ("alrf 541x361 σ=0", Box::new(alrf(0.5, 0.0, false)), SegmentConfig::exact()),
+        ("alrf 541x361 σ=3cm+mixed", Box::new(alrf(0.5, 0.03, true)), SegmentConfig::alrf()),
+        ("alrf 541x361 σ=6cm+mixed", Box::new(alrf(0.5, 0.06, true)), alrf_scaled(2.0)),
+        ("sr3000 176x144 σ=0", Box::new(camera(0.0)), SegmentConfig::exact()),
+        ("sr3000 176x144 σ=1cm", Box::new(camera(0.01)), SegmentConfig::range_camera()),
+        ("sr3000 176x144 σ=2cm", Box::new(camera(0.02)), camera_scaled(2.0)),
+    ];
+    for (name, sensor, config) in runs {
+        let mut line = Vec::new();
+        let (mut ms, mut totals) = (0.0, [0usize; 6]);
+        let mut angles = Vec::new();
+        for (k, body) in bodies.iter().enumerate() {
+            let pose = sensor.mount(body);
+            let scan = sensor.scan(&scene, &pose, 11 + k as u64);
+            let mut cloud = scan.to_cloud().unwrap();
+            if let BeamModel::ActuatedLrf(model) = scan.image.beams() {
+                cloud = invalidate_alrf_side_columns(&cloud, model, &AlrfSideColumns::thesis())
+                    .unwrap()
+                    .0;
+            }
+            let start = Instant::now();
+            let seg = segment(&cloud, &config).unwrap();
+            let elapsed = start.elapsed().as_secs_f64() * 1e3;
+            ms += elapsed;
+            let report = segcomp(cloud.labels().unwrap(), &seg, &SegCompConfig::hoover(200), |l| {
+                plane_in_sensor(&scene, &scan.pose, l)
+            })
+            .unwrap();
+            let counts = [
+                report.num_truth,
+                report.correct.len(),
+                report.over.len(),
+                report.under.len(),
+                report.missed.len(),
+                report.noise.len(),
+            ];
+            for (t, c) in totals.iter_mut().zip(counts) {
+                *t += c;
+            }
+            angles.extend(report.angle_errors());
+            line.push(format!("{} pts {elapsed:.1} ms", cloud.len()));
+        }
+        let mean = angles.iter().sum::<Real>() / angles.len().max(1) as Real;
+        let max = angles.iter().copied().fold(0.0, Real::max);
+        println!(
+            "{name}: [{}] mean {:.1} ms/scan; GT {} correct {} over {} under {} missed {} noise {}; \
+             angle mean {mean:.3}° max {max:.3}°",
+            line.join(", "),
+            ms / bodies.len() as Real,
+            totals[0],
+            totals[1],
+            totals[2],
+            totals[3],
+            totals[4],
+            totals[5]
+        );
+    }
+}
+
+fn alrf_scaled(f: Real) -> SegmentConfig {
+    let mut c = SegmentConfig::alrf();
+    c.noise.sigma_0 *= f;
+    c
+}
+
+fn camera_scaled(f: Real) -> SegmentConfig {
+    let mut c = SegmentConfig::range_camera();
+    c.noise.sigma_0 *= f;
+    c
+}
+
+#[test]
+#[ignore]
+fn zz_debug() {
+    let scene = scene_sim::scene_by_name("lab", 7).unwrap();
+    let body = scene.scan_poses(1, 0.8, 7)[0];
+    let sensor = alrf(0.5, 0.03, false);
+    let scan = sensor.scan(&scene, &body, 11);
+    let cloud = scan.to_cloud().unwrap();
+    let BeamModel::ActuatedLrf(model) = sensor.beam_model() else { unreachable!() };
+    let (cloud, _) = invalidate_alrf_side_columns(&cloud, &model, &AlrfSideColumns::thesis()).unwrap();
+    let labels = cloud.labels().unwrap();
+    for min in [100, 30] {
+    let config = SegmentConfig { min_region_size: min, ..SegmentConfig::alrf() };
+    let seg = segment(&cloud, &config).unwrap();
+    let report = segcomp(labels, &seg, &SegCompConfig::hoover(200), |l| plane_in_sensor(&scene, &scan.pose, l)).unwrap();
+    println!("{report}");
+    let mut owner = vec![usize::MAX; cloud.len()];
+    for (k, r) in seg.regions.iter().enumerate() { for &i in &r.points { owner[i as usize] = k; } }
+    let missed_or_over: Vec<u32> = report.missed.iter().copied().chain(report.over.iter().map(|o| o.truth)).collect();
+    for m in missed_or_over {
+        let mut o = std::collections::BTreeMap::new();
+        let mut size = 0;
+        let mut rsum = 0.0;
+        for (i, &l) in labels.iter().enumerate() { if l == m { size += 1; rsum += cloud.positions()[i].coords.norm(); *o.entry(owner[i] as i64).or_insert(0usize) += 1; } }
+        let name = &scene.surface(SurfaceId(m)).unwrap().name;
+        let sizes: Vec<String> = o.iter().map(|(k, v)| format!("{k}:{v}/{}", if *k >= 0 { seg.regions[*k as usize].points.len() } else { 0 })).collect();
+        println!("{m} {name} size {size} range {:.1}: {}", rsum / size as Real, sizes.join(" "));
+    }
+    }
+}
