@@ -1,4 +1,33 @@
-//! Planar patches from range data (thesis §5.3).
+//! Planar patches from range data (thesis §5.3, spec §2): plane segmentation of organised and
+//! unorganised scans, projection of the regions onto their planes, outlines and
+//! triangulations of the thesis's survey, outline simplification, trimesh growing for the
+//! non-planar remainder, and outline merging across scans; [`pipeline::extract`] runs them all.
+//!
+//! | stage | module | thesis |
+//! |---|---|---|
+//! | incremental least-squares plane fit | [`plane_fit`] | §5.3.2 (orthogonal LSQ, L4624–4628) |
+//! | region growing segmentation | [`segment`] | [Poppinga 2008b], undescribed in the thesis: our method is documented in the module |
+//! | segmentation quality (SegComp, Hoover et al. 1996) | [`evaluate`] | — |
+//! | projection: early/late, orthogonal/along the beam; ALRF ±90° columns | [`projection`] | §5.3.2, App. A |
+//! | α-shapes with the optimal α for one component | [`alpha_shape`] | Alg 6, L4839–4909 |
+//! | convex hull | [`hull`] | survey, L4811 |
+//! | naive range-image triangulation | [`grid_mesh`] | L4913–4915 |
+//! | convex grid polygons (scanLine V1, V2) | [`scanline`] | Alg 7, Alg 8, L4911–5146 |
+//! | chain-code outlines | [`chain_code`] | survey, L4831–4837 |
+//! | Douglas–Peucker | [`simplify`] | §5.3.4, L5249–5353 |
+//! | region → planar patch (projection, α-shape, DP) | [`polygonize`] | Ch.6 pipeline, L5341–5343 |
+//! | spikyness, mesh statistics, outline fidelity | [`quality`] | L5148–5154 |
+//! | trimesh growing (Alg 4 and 5) | [`trimesh_grow`] | L4484–4620 |
+//! | outline merging across scans | [`merge`] | §5.1 |
+//! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
+//!
+//! Every parameter the thesis leaves open (segmentation thresholds, α rule details, DP ε,
+//! θ_ang, θ_d, θ_s, merging tolerances) is a field of a config struct with named presets and
+//! the choice documented where it is made. Bad input (empty clouds, degenerate regions, absurd
+//! parameters) gives typed errors, never panics.
+//!
+//! Extraction produces `patch-core` patches and never names a map backend: any `patch-map`
+//! backend takes its output.
 
 pub mod alpha_shape;
 pub mod chain_code;
@@ -17,4 +46,9 @@ pub mod segment;
 pub mod simplify;
 pub mod trimesh_grow;
 
+pub use merge::{MergeConfig, merge_coplanar};
+pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
+pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
+pub use segment::{SegmentConfig, segment};
+pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};

@@ -1,1 +1,239 @@
-//! Placeholder.
+//! One call from scans to patches (thesis §5.3 and the Ch.6 pipeline, L5341–5343, L6580–6700):
+//! per scan, plane segmentation ([`crate::segment`]) → early orthogonal projection, α-shape,
+//! Douglas–Peucker ([`crate::polygonize`]) → planar patches; optionally trimesh growing on the
+//! remainder ([`crate::trimesh_grow`], the thesis's hybrid maps); every patch moved to the world
+//! by the scan's pose; then optionally outline merging across scans ([`crate::merge`]). Every
+//! stage is timed.
+//!
+//! Scans are organised or unorganised [`PointCloud`]s **in their sensor frame** with their
+//! [`PointCloud::sensor_pose`] set (as range images and simulated scans give them); a cloud
+//! without a pose is taken as a scan from the world origin. Trimesh growing needs the pixel
+//! grid, so the remainder of an unorganised scan is reported but not meshed.
+//!
+//! A region that polygonisation refuses (too few distinct points after projection, a degenerate
+//! outline) is counted in [`ScanReport::failed_regions`] with its reason in
+//! [`ScanReport::failures`]; it never stops the pipeline. Extraction from actuated-LRF scans
+//! should first drop the ±90° columns ([`crate::projection::invalidate_alrf_side_columns`],
+//! thesis App. A), which needs the scan's beam model and so is the caller's step.
+
+use crate::grid_mesh::RegionMask;
+use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
+use crate::polygonize::{PolygonizeConfig, polygonize_region};
+use crate::segment::{SegmentConfig, SegmentError, segment};
+use crate::trimesh_grow::{TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
+use patch_core::{Isometry3, Patch, PlanarPatch};
+use pointcloud::PointCloud;
+use std::time::{Duration, Instant};
+
+/// Every stage's parameters. No `Default`: start from a sensor preset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PipelineConfig {
+    /// Plane segmentation.
+    pub segment: SegmentConfig,
+    /// Projection, outline and simplification of each region.
+    pub polygonize: PolygonizeConfig,
+    /// Trimesh growing on the remainder (hybrid maps, thesis §6.1); `None`: planes only.
+    pub remainder: Option<TrimeshGrowConfig>,
+    /// Outline merging across scans; `None`: every scan's patches are kept as they are.
+    pub merge: Option<MergeConfig>,
+}
+
+impl PipelineConfig {
+    /// For actuated-LRF scans (S300-like, 1–3 cm noise): [`SegmentConfig::alrf`],
+    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    pub fn alrf() -> PipelineConfig {
+        PipelineConfig {
+            segment: SegmentConfig::alrf(),
+            polygonize: PolygonizeConfig::thesis(),
+            remainder: None,
+            merge: Some(MergeConfig::alrf()),
+        }
+    }
+
+    /// For range-camera frames (SR-3000-like): [`SegmentConfig::range_camera`],
+    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    pub fn range_camera() -> PipelineConfig {
+        PipelineConfig {
+            segment: SegmentConfig::range_camera(),
+            polygonize: PolygonizeConfig::thesis(),
+            remainder: None,
+            merge: Some(MergeConfig::alrf()),
+        }
+    }
+
+    /// For noise-free scans of synthetic scenes: [`SegmentConfig::exact`],
+    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::exact`].
+    pub fn exact() -> PipelineConfig {
+        PipelineConfig {
+            segment: SegmentConfig::exact(),
+            polygonize: PolygonizeConfig::thesis(),
+            remainder: None,
+            merge: Some(MergeConfig::exact()),
+        }
+    }
+
+    /// This configuration with trimesh patches for the remainder (a hybrid map).
+    pub fn with_remainder(mut self, config: TrimeshGrowConfig) -> PipelineConfig {
+        self.remainder = Some(config);
+        self
+    }
+}
+
+/// Why the pipeline stopped. Bad regions do not stop it (see [`ScanReport::failures`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ExtractError {
+    /// The segmentation refused its parameters.
+    #[error("scan {scan}: segmentation: {source}")]
+    Segment {
+        /// Index of the scan.
+        scan: usize,
+        /// The reason.
+        source: SegmentError,
+    },
+    /// Trimesh growing refused its parameters.
+    #[error("scan {scan}: trimesh growing: {source}")]
+    Trimesh {
+        /// Index of the scan.
+        scan: usize,
+        /// The reason.
+        source: TrimeshGrowError,
+    },
+    /// Merging refused its parameters.
+    #[error("merging: {0}")]
+    Merge(#[from] MergeError),
+    /// A scan's pose is not finite.
+    #[error("scan {scan}: the sensor pose is not finite")]
+    BadPose {
+        /// Index of the scan.
+        scan: usize,
+    },
+}
+
+/// What happened to one scan.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ScanReport {
+    /// Valid points of the scan.
+    pub points: usize,
+    /// Planar regions found.
+    pub regions: usize,
+    /// Points in planar regions.
+    pub region_points: usize,
+    /// Planar patches made from the regions.
+    pub planar_patches: usize,
+    /// Regions that could not be polygonised.
+    pub failed_regions: usize,
+    /// The first few reasons (at most 8), for diagnosis.
+    pub failures: Vec<String>,
+    /// Points in no region.
+    pub remainder_points: usize,
+    /// Trimesh patches grown on the remainder.
+    pub trimesh_patches: usize,
+    /// Outline vertices before and after simplification, summed over the regions.
+    pub outline_vertices: (usize, usize),
+}
+
+/// Wall time per stage, summed over the scans.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    /// Plane segmentation.
+    pub segmentation: Duration,
+    /// Projection, outlines, simplification, patch building.
+    pub polygonization: Duration,
+    /// Trimesh growing on the remainders.
+    pub trimesh: Duration,
+    /// Outline merging across scans.
+    pub merging: Duration,
+}
+
+impl StageTimes {
+    /// The sum of the stages.
+    pub fn total(&self) -> Duration {
+        self.segmentation + self.polygonization + self.trimesh + self.merging
+    }
+}
+
+/// The patches of a set of scans, in the world frame, and how they were made.
+#[derive(Clone, Debug, Default)]
+pub struct Extraction {
+    /// Planar patches first (merged if asked), then the trimesh patches.
+    pub patches: Vec<Patch>,
+    /// One report per scan.
+    pub scans: Vec<ScanReport>,
+    /// What merging did, if it ran.
+    pub merge: Option<MergeStats>,
+    /// Time per stage.
+    pub times: StageTimes,
+}
+
+/// Extracts the patches of `scans` (see the module docs); `progress` is called after each scan
+/// with its index.
+///
+/// # Errors
+/// [`ExtractError`] for refused parameters or a non-finite pose; never for the content of a
+/// scan (an empty scan gives no patches).
+pub fn extract(
+    scans: &[PointCloud],
+    config: &PipelineConfig,
+    mut progress: impl FnMut(usize),
+) -> Result<Extraction, ExtractError> {
+    let mut out = Extraction::default();
+    let mut planar: Vec<PlanarPatch> = Vec::new();
+    let mut meshes: Vec<Patch> = Vec::new();
+    for (index, scan) in scans.iter().enumerate() {
+        let motion = match scan.sensor_pose() {
+            Some(pose) if !pose.is_finite() => return Err(ExtractError::BadPose { scan: index }),
+            Some(pose) => pose.world_from_sensor,
+            None => Isometry3::identity(),
+        };
+        let mut report = ScanReport { points: scan.len(), ..ScanReport::default() };
+        let t = Instant::now();
+        let segmentation = segment(scan, &config.segment)
+            .map_err(|source| ExtractError::Segment { scan: index, source })?;
+        out.times.segmentation += t.elapsed();
+        report.regions = segmentation.regions.len();
+        report.region_points = segmentation.regions.iter().map(|r| r.points.len()).sum();
+        report.remainder_points = segmentation.remainder.len();
+
+        let t = Instant::now();
+        for region in &segmentation.regions {
+            match polygonize_region(scan, region, &config.polygonize) {
+                Ok(p) => {
+                    report.planar_patches += p.patches.len();
+                    report.outline_vertices.0 += p.vertices_before;
+                    report.outline_vertices.1 += p.vertices_after;
+                    planar.extend(p.patches.iter().map(|patch| patch.transformed(&motion)));
+                }
+                Err(e) => {
+                    report.failed_regions += 1;
+                    if report.failures.len() < 8 {
+                        report.failures.push(e.to_string());
+                    }
+                }
+            }
+        }
+        out.times.polygonization += t.elapsed();
+
+        if let (Some(grow), Some(grid)) = (&config.remainder, scan.grid()) {
+            let t = Instant::now();
+            let mask = RegionMask::from_points(grid, &segmentation.remainder);
+            let grown = grow_trimeshes_in(scan, &mask, grow)
+                .map_err(|source| ExtractError::Trimesh { scan: index, source })?;
+            report.trimesh_patches = grown.meshes.len();
+            meshes.extend(
+                grown.into_patches().into_iter().map(|m| Patch::Trimesh(m.transformed(&motion))),
+            );
+            out.times.trimesh += t.elapsed();
+        }
+        out.scans.push(report);
+        progress(index);
+    }
+    if let Some(merge) = &config.merge {
+        let t = Instant::now();
+        let (merged, stats) = merge_coplanar(&planar, merge)?;
+        planar = merged;
+        out.merge = Some(stats);
+        out.times.merging += t.elapsed();
+    }
+    out.patches = planar.into_iter().map(Patch::Planar).chain(meshes).collect();
+    Ok(out)
+}

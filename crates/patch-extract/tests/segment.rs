@@ -387,34 +387,3 @@ fn camera_scaled(f: Real) -> SegmentConfig {
     c.noise.sigma_0 *= f;
     c
 }
-
-#[test]
-#[ignore]
-fn zz_debug() {
-    let scene = scene_sim::scene_by_name("lab", 7).unwrap();
-    let body = scene.scan_poses(1, 0.8, 7)[0];
-    let sensor = alrf(0.5, 0.03, false);
-    let scan = sensor.scan(&scene, &body, 11);
-    let cloud = scan.to_cloud().unwrap();
-    let BeamModel::ActuatedLrf(model) = sensor.beam_model() else { unreachable!() };
-    let (cloud, _) = invalidate_alrf_side_columns(&cloud, &model, &AlrfSideColumns::thesis()).unwrap();
-    let labels = cloud.labels().unwrap();
-    for min in [100, 30] {
-    let config = SegmentConfig { min_region_size: min, ..SegmentConfig::alrf() };
-    let seg = segment(&cloud, &config).unwrap();
-    let report = segcomp(labels, &seg, &SegCompConfig::hoover(200), |l| plane_in_sensor(&scene, &scan.pose, l)).unwrap();
-    println!("{report}");
-    let mut owner = vec![usize::MAX; cloud.len()];
-    for (k, r) in seg.regions.iter().enumerate() { for &i in &r.points { owner[i as usize] = k; } }
-    let missed_or_over: Vec<u32> = report.missed.iter().copied().chain(report.over.iter().map(|o| o.truth)).collect();
-    for m in missed_or_over {
-        let mut o = std::collections::BTreeMap::new();
-        let mut size = 0;
-        let mut rsum = 0.0;
-        for (i, &l) in labels.iter().enumerate() { if l == m { size += 1; rsum += cloud.positions()[i].coords.norm(); *o.entry(owner[i] as i64).or_insert(0usize) += 1; } }
-        let name = &scene.surface(SurfaceId(m)).unwrap().name;
-        let sizes: Vec<String> = o.iter().map(|(k, v)| format!("{k}:{v}/{}", if *k >= 0 { seg.regions[*k as usize].points.len() } else { 0 })).collect();
-        println!("{m} {name} size {size} range {:.1}: {}", rsum / size as Real, sizes.join(" "));
-    }
-    }
-}
