@@ -129,6 +129,33 @@ fn inside(rings: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
     odd
 }
 
+/// The world triangles of a patch: a planar patch's polygon triangulated by
+/// [`triangulate_polygon`] and mapped to the world, or a mesh's own triangles.
+///
+/// # Errors
+/// [`TriangulationError`] if the polygon cannot be triangulated (only for coordinates beyond
+/// the exact predicates' range: validated polygons have no crossing rings).
+pub fn patch_triangles(
+    patch: &crate::Patch,
+) -> Result<Vec<[crate::Point3; 3]>, TriangulationError> {
+    match patch {
+        crate::Patch::Planar(p) => {
+            let rings: Vec<Vec<[f64; 2]>> = p
+                .polygon()
+                .rings()
+                .map(|r| r.points().iter().map(|q| [q.x, q.y]).collect())
+                .collect();
+            let t = triangulate_polygon(&rings)?;
+            let world = |k: u32| {
+                let [x, y] = t.vertices[k as usize];
+                p.to_world(&crate::Point2::new(x, y))
+            };
+            Ok(t.triangles.iter().map(|tri| tri.map(world)).collect())
+        }
+        crate::Patch::Trimesh(m) => Ok((0..m.num_triangles()).map(|i| m.triangle(i)).collect()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,7 +6,7 @@
 //! | stage | module | thesis |
 //! |---|---|---|
 //! | incremental least-squares plane fit | [`plane_fit`] | §5.3.2 (orthogonal LSQ, L4624–4628) |
-//! | region growing segmentation | [`segment`] | [Poppinga 2008b], undescribed in the thesis: our method is documented in the module |
+//! | region growing segmentation | [`mod@segment`] | Poppinga et al. 2008, undescribed in the thesis: our method is documented in the module |
 //! | segmentation quality (SegComp, Hoover et al. 1996) | [`evaluate`] | — |
 //! | projection: early/late, orthogonal/along the beam; ALRF ±90° columns | [`projection`] | §5.3.2, App. A |
 //! | α-shapes with the optimal α for one component | [`alpha_shape`] | Alg 6, L4839–4909 |

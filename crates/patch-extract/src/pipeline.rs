@@ -1,5 +1,5 @@
 //! One call from scans to patches (thesis §5.3 and the Ch.6 pipeline, L5341–5343, L6580–6700):
-//! per scan, plane segmentation ([`crate::segment`]) → early orthogonal projection, α-shape,
+//! per scan, plane segmentation ([`mod@crate::segment`]) → early orthogonal projection, α-shape,
 //! Douglas–Peucker ([`crate::polygonize`]) → planar patches; optionally trimesh growing on the
 //! remainder ([`crate::trimesh_grow`], the thesis's hybrid maps); every patch moved to the world
 //! by the scan's pose; then optionally outline merging across scans ([`crate::merge`]). Every

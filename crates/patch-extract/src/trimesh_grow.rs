@@ -12,7 +12,7 @@
 //!   with fewer have no plane, and their triangles are not growable). A triangle is *growable*
 //!   iff over its vertex pairs the largest normal angle is below `θ_ang` and the largest `|Δd|`
 //!   below `θ_d`. From every quad, in raster order, a breadth-first search starting at its `T₀`
-//!   and then at its `T₁` (both triangles seed, see the spec's [R] note) collects unused
+//!   and then at its `T₁` (both triangles seed, as the spec recommends) collects unused
 //!   growable triangles; each search gives one mesh, empty ones are skipped.
 //! * **Phase 2** (Alg 5). The same search over the triangles phase 1 did not use, accepting a
 //!   triangle iff both of its pixel-axis-aligned sides are shorter than `θ_s` metres.

@@ -12,8 +12,8 @@
 //! therefore contains a sample: with `h < r/2` the point-cloud map's Algorithm 10 cannot miss
 //! such a step (the density assumption of [`point_cloud`](crate::point_cloud)).
 
-use crate::triangulate::{TriangulationError, triangulate_polygon};
-use patch_core::{Patch, Point2, Point3, Real};
+use crate::triangulate::{TriangulationError, patch_triangles};
+use patch_core::{Patch, Point3, Real};
 
 /// Appends the lattice samples of one triangle with spacing at most `spacing`.
 fn sample_triangle(corners: [Point3; 3], spacing: Real, out: &mut Vec<Point3>) {
@@ -55,28 +55,10 @@ pub fn sample_patch_points(patches: &[Patch], spacing: Real) -> Result<Vec<Point
     }
     let mut out = Vec::new();
     for (index, patch) in patches.iter().enumerate() {
-        match patch {
-            Patch::Planar(p) => {
-                let rings: Vec<Vec<[Real; 2]>> = p
-                    .polygon()
-                    .rings()
-                    .map(|r| r.points().iter().map(|q| [q.x, q.y]).collect())
-                    .collect();
-                let t = triangulate_polygon(&rings)
-                    .map_err(|source| SamplingError::Triangulation { patch: index, source })?;
-                let world = |k: u32| {
-                    let [x, y] = t.vertices[k as usize];
-                    p.to_world(&Point2::new(x, y))
-                };
-                for tri in &t.triangles {
-                    sample_triangle(tri.map(world), spacing, &mut out);
-                }
-            }
-            Patch::Trimesh(m) => {
-                for i in 0..m.num_triangles() {
-                    sample_triangle(m.triangle(i), spacing, &mut out);
-                }
-            }
+        let triangles = patch_triangles(patch)
+            .map_err(|source| SamplingError::Triangulation { patch: index, source })?;
+        for tri in triangles {
+            sample_triangle(tri, spacing, &mut out);
         }
     }
     Ok(out)
@@ -85,7 +67,7 @@ pub fn sample_patch_points(patches: &[Patch], spacing: Real) -> Result<Vec<Point
 #[cfg(test)]
 mod tests {
     use super::*;
-    use patch_core::{BruteForceMap, FromPatches, Isometry3, PlanarPatch, ProximityQuery};
+    use patch_core::{BruteForceMap, FromPatches, Isometry3, PlanarPatch, Point2, ProximityQuery};
 
     #[test]
     fn samples_cover_a_patch_and_lie_on_it() {
