@@ -4,6 +4,7 @@
 //! patchnav info FILE                      what a file holds
 //! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
+//! patchnav extract SCANS... --out MAP [--sensor alrf|range-camera|exact] [--hybrid] [--export F.obj]
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
 //! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]
@@ -20,6 +21,7 @@ use std::process::ExitCode;
 
 mod convert;
 mod experiment;
+mod extract;
 mod info;
 mod input;
 mod map;
@@ -60,6 +62,8 @@ enum Command {
     },
     /// Scan a synthetic scene with a simulated sensor from several poses.
     Simulate(simulate::SimulateArgs),
+    /// Planar (and trimesh) patches from range scans, merged across scans, as a map file.
+    Extract(extract::ExtractArgs),
     /// Build and inspect map files.
     #[command(subcommand)]
     Map(map::MapCommand),
@@ -79,6 +83,7 @@ fn main() -> ExitCode {
             convert::run(&input, &output, &options, &progress)
         }
         Command::Simulate(args) => simulate::run(&args, &progress),
+        Command::Extract(args) => extract::run(&args, &progress),
         Command::Map(command) => map::run(&command, &progress),
         Command::Plan(args) => plan::run(&args, &progress),
         Command::Experiment(command) => experiment::run(&command, &progress),

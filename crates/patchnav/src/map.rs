@@ -53,6 +53,13 @@ pub enum BackendChoice {
     Pointcloud,
 }
 
+impl BackendChoice {
+    /// The name on the command line.
+    pub fn name(self) -> String {
+        self.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default()
+    }
+}
+
 /// Arguments of `patchnav map build`.
 #[derive(Args, Debug)]
 pub struct BuildArgs {
@@ -201,35 +208,22 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         _ => bail!("give an INPUT file, or --scene with --kind"),
     };
     let spinner = progress.spinner("building");
-    let patches = |what: &str| -> Result<Vec<Patch>> {
-        match &source {
-            Source::Patches(p) => Ok(p.clone()),
-            Source::Points(_) => bail!(
-                "{label}: a point cloud has no patches; the {what} backend needs a mesh or a patch map \
-                 (or use --backend pointcloud)"
-            ),
+    let (bytes, memory) = match (&source, args.backend) {
+        (Source::Patches(patches), backend) => {
+            save_patches(patches.clone(), backend, args.spacing, &args.out)
+                .with_context(|| label.clone())?
         }
-    };
-    let (bytes, memory) = match args.backend {
-        BackendChoice::Polygon => save(&PolygonMap::from_patches(patches("polygon")?)?, &args.out)?,
-        BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches("bbox6d")?)?, &args.out)?,
-        BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches("trimesh")?)?, &args.out)?,
-        BackendChoice::Rapier => save(&RapierMap::from_patches(patches("rapier")?)?, &args.out)?,
-        BackendChoice::Pointcloud => match (&source, args.spacing) {
-            (Source::Points(points), None) => {
-                save(&PointCloudMap::from_points(points)?, &args.out)?
+        (Source::Points(points), BackendChoice::Pointcloud) => {
+            if args.spacing.is_some() {
+                bail!("--spacing applies to patch inputs; a point cloud is used as it is");
             }
-            (Source::Points(_), Some(_)) => {
-                bail!("--spacing applies to patch inputs; a point cloud is used as it is")
-            }
-            (Source::Patches(patches), Some(spacing)) => {
-                let points = sample_patch_points(patches, spacing)?;
-                save(&PointCloudMap::from_points(&points)?, &args.out)?
-            }
-            (Source::Patches(_), None) => bail!(
-                "{label}: the pointcloud backend needs a point cloud, or --spacing to sample the patches"
-            ),
-        },
+            save(&PointCloudMap::from_points(points)?, &args.out)?
+        }
+        (Source::Points(_), backend) => bail!(
+            "{label}: a point cloud has no patches; the {} backend needs a mesh or a patch map \
+             (or use --backend pointcloud)",
+            backend.name()
+        ),
     };
     spinner.finish_and_clear();
     progress.say(format!(
@@ -238,6 +232,30 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         args.backend
     ));
     Ok(())
+}
+
+/// Writes `patches` as a map file of `backend` (`spacing`: the sample spacing of a point-cloud
+/// map made from patches, which it needs); returns the bytes on disk and in memory.
+pub fn save_patches(
+    patches: Vec<Patch>,
+    backend: BackendChoice,
+    spacing: Option<f64>,
+    out: &Path,
+) -> Result<(u64, usize)> {
+    Ok(match backend {
+        BackendChoice::Polygon => save(&PolygonMap::from_patches(patches)?, out)?,
+        BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches)?, out)?,
+        BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches)?, out)?,
+        BackendChoice::Rapier => save(&RapierMap::from_patches(patches)?, out)?,
+        BackendChoice::Pointcloud => match spacing {
+            Some(spacing) => {
+                save(&PointCloudMap::from_points(&sample_patch_points(&patches, spacing)?)?, out)?
+            }
+            None => bail!(
+                "the pointcloud backend needs a point cloud, or --spacing to sample the patches"
+            ),
+        },
+    })
 }
 
 /// The bounding box of a map's patches or points.
