@@ -4,12 +4,15 @@
 //! * `office`: the preliminary experiment of §5.5.3 (Tables 5.3–5.11);
 //! * `lab-timing`: RRT time against iterations on the lab's planes, hybrid, trimesh and
 //!   point-cloud maps (§6.1.3, Fig 6.4), as CSV and SVG;
-//! * `lab-volume`: explored volume and its congruence tables (§6.1.1, Tables 6.2 and 6.4).
+//! * `lab-volume`: explored volume and its congruence tables (§6.1.1, Tables 6.2 and 6.4);
+//! * `extraction`: patch extraction quality, the outlining survey and patch sizes (§5.3,
+//!   Figs 5.12–5.14, Table 5.1).
 
 use crate::progress::Progress;
 use anyhow::Result;
 use clap::Subcommand;
 
+mod extraction;
 mod lab;
 mod office;
 
@@ -25,6 +28,9 @@ pub enum ExperimentCommand {
     /// Thesis Tables 6.2 and 6.4: explored volume of RRT and PRM on the lab's four map types
     /// and the congruence table between them.
     LabVolume(lab::LabVolumeArgs),
+    /// Thesis §5.3: segmentation quality (SegComp), the outlining survey (Figs 5.12–5.14),
+    /// outline fidelity and patch sizes (Table 5.1) on simulated and real scans.
+    Extraction(extraction::ExtractionArgs),
 }
 
 /// Runs `patchnav experiment ...`.
@@ -33,5 +39,6 @@ pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
         ExperimentCommand::Office(args) => office::run(args, progress),
         ExperimentCommand::LabTiming(args) => lab::run_timing(args, progress),
         ExperimentCommand::LabVolume(args) => lab::run_volume(args, progress),
+        ExperimentCommand::Extraction(args) => extraction::run(args, progress),
     }
 }
