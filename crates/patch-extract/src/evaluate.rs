@@ -32,8 +32,8 @@
 //! (in the cloud's frame), the angle between the region's normal and the true normal,
 //! `acos |n · n_true|` in degrees (orientation ignored).
 
-use crate::region::Segmentation;
-use patch_core::{Plane, Real};
+use crate::region::{PlanarRegion, Segmentation};
+use patch_core::{Plane, Point3, Real};
 use std::collections::HashMap;
 use std::fmt;
 
@@ -317,6 +317,30 @@ pub fn segcomp(
         missed,
         noise,
     })
+}
+
+/// The ground-truth segmentation of a labelled cloud: one region per label with at least
+/// `min_size` points (label `unlabelled` excluded), each with its least-squares plane seen from
+/// the sensor at the origin ([`PlanarRegion::fit`]); regions ordered by label. Labels of
+/// simulated scans are the surfaces their beams hit, so this is the segmentation SegComp
+/// compares against; it is also the input of the outlining survey's "truth" regions.
+pub fn truth_regions(
+    labels: &[u32],
+    positions: &[Point3],
+    min_size: usize,
+    unlabelled: u32,
+) -> Vec<PlanarRegion> {
+    let mut by_label: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+    for (i, &l) in labels.iter().enumerate() {
+        if l != unlabelled {
+            by_label.entry(l).or_default().push(i as u32);
+        }
+    }
+    by_label
+        .into_values()
+        .filter(|points| points.len() >= min_size.max(3))
+        .filter_map(|points| PlanarRegion::fit(positions, points, &Point3::origin()))
+        .collect()
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! The result of plane segmentation: planar regions of a cloud and the remainder.
 
+use crate::plane_fit::PlaneAccumulator;
 use patch_core::{Plane, PlaneCovariance, Point3, Real};
 
 /// One planar region of a point cloud: the indices of its points in the cloud, the plane fitted
@@ -17,6 +18,29 @@ pub struct PlanarRegion {
     pub mse: Real,
     /// The covariance of `(n, d)` from the fit, when the segmentation computes it.
     pub covariance: Option<PlaneCovariance>,
+}
+
+impl PlanarRegion {
+    /// The region of the points `points` (indices into `positions`, sorted here) with the
+    /// least-squares plane fitted to them, its normal toward `viewpoint` (the sensor; the
+    /// origin for clouds in the sensor frame). `None` for fewer than three points, collinear
+    /// points or an index out of range.
+    pub fn fit(positions: &[Point3], mut points: Vec<u32>, viewpoint: &Point3) -> Option<Self> {
+        points.sort_unstable();
+        points.dedup();
+        let mut acc = PlaneAccumulator::new();
+        for &i in &points {
+            acc.add(positions.get(i as usize)?);
+        }
+        let fit = acc.fit(viewpoint)?;
+        Some(PlanarRegion {
+            points,
+            plane: fit.plane,
+            centroid: fit.centroid,
+            mse: fit.mse,
+            covariance: fit.covariance(),
+        })
+    }
 }
 
 /// Planar regions and the points that belong to none (the remainder cloud, thesis L4502–4506:

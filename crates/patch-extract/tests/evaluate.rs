@@ -2,7 +2,6 @@
 
 use patch_core::{Plane, Point3, UnitVector3};
 use patch_extract::evaluate::{OverSegmentation, SegCompConfig, UnderSegmentation, segcomp};
-use patch_extract::plane_fit::PlaneAccumulator;
 use patch_extract::{PlanarRegion, Segmentation};
 use pointcloud::{PointCloud, SensorPose};
 use scene_sim::{RangeCamera, RangeCameraConfig, RangeSensor, Scene, SurfaceId};
@@ -29,17 +28,8 @@ fn plane_in_sensor(scene: &Scene, pose: &SensorPose, surface: u32) -> Option<Pla
     Some(Plane { normal, offset })
 }
 
-fn region(cloud: &PointCloud, mut points: Vec<u32>) -> PlanarRegion {
-    points.sort_unstable();
-    let acc = PlaneAccumulator::from_points(points.iter().map(|&i| &cloud.positions()[i as usize]));
-    let fit = acc.fit(&Point3::origin()).unwrap();
-    PlanarRegion {
-        points,
-        plane: fit.plane,
-        centroid: fit.centroid,
-        mse: fit.mse,
-        covariance: fit.covariance(),
-    }
+fn region(cloud: &PointCloud, points: Vec<u32>) -> PlanarRegion {
+    PlanarRegion::fit(cloud.positions(), points, &Point3::origin()).unwrap()
 }
 
 /// The points of each label with at least `min` points, largest first.
