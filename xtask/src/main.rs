@@ -5,6 +5,10 @@
 //! * `cargo xtask bench [NAME ...] [--seed N] [--out FILE]`: runs named benchmarks of the
 //!   `bench-matrix` program in release mode and appends one JSON line per measurement, with the
 //!   provenance of the run (git revision, host, CPU, date, seed), to `target/bench/results.jsonl`.
+//! * `cargo xtask peers planes [--peers-dir DIR] [--peers-build DIR] [--bench-dir DIR] [--out F]`:
+//!   our plane extraction beside PCL's and Open3D's on the shared floor-plan clouds, one process
+//!   per run, quality against the floor plan's mesh; JSONL rows to `target/peers/planes.jsonl`
+//!   and a side-by-side table on stdout (docs/extraction-peers.md).
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -12,6 +16,7 @@ use std::process::ExitCode;
 
 mod bench;
 mod fixtures;
+mod peers;
 mod provenance;
 
 const USAGE: &str = "\
@@ -21,6 +26,8 @@ commands:
   fixtures [--check]                    regenerate fixtures/ (or check they are current)
   bench [NAME ...] [--seed N] [--out F] run named benchmarks (default: all), append JSONL rows
   bench --list                          list the benchmark names
+  peers planes [--peers-dir D] [--peers-build D] [--bench-dir D] [--out F]
+                                        our plane extraction beside PCL and Open3D (same inputs)
 ";
 
 fn main() -> ExitCode {
@@ -61,6 +68,7 @@ fn try_main() -> Result<()> {
             Ok(())
         }
         "bench" => bench::run(rest),
+        "peers" => peers::run(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
             Ok(())

@@ -1,5 +1,5 @@
 //! `patchnav extract SCANS... --out MAP [--backend B] [--sensor S] [--hybrid] [--no-merge]
-//! [--poses FILE] [--export FILE.obj]`: planar patches (and, with `--hybrid`, trimesh patches
+//! [--poses FILE] [--export FILE.obj] [--jsonl FILE] [--polygons FILE]`: planar patches (and, with `--hybrid`, trimesh patches
 //! for the non-planar remainder) from range scans, merged across scans, written as a map file
 //! of any patch backend (thesis §5.3, §6.1; `patch_extract::pipeline`).
 //!
@@ -7,6 +7,20 @@
 //! simulate` carry it, PCD files have `VIEWPOINT`, 3DTK `.3d` scans the sibling `.pose` file.
 //! `--poses FILE` overrides them with the `poses.json` layout `patchnav simulate` writes
 //! (`{"scans": [{"file": NAME, "world_from_sensor": 4×4 rows}, ...]}`, matched by file name).
+//!
+//! `--jsonl FILE` appends one line per run in the peers' result format (`shared/peers/FORMAT.md`
+//! §4, kind `planes`), so that `summarize.py` and `cargo xtask peers planes` read our runs beside
+//! PCL's and Open3D's; `--polygons FILE` writes the planar patches in the peers' plane-polygon
+//! format (§5). The mapping of our figures onto those keys:
+//!
+//! | key | ours |
+//! |---|---|
+//! | `planes`, `inliers` | planar regions of the segmentation and their points, summed over the scans |
+//! | `polygons`, `polygon_vertices` | planar patches written (after merging) and their outline vertices (outer rings and holes) |
+//! | `time_normals_s` | `null`: the segmentation fits its seed windows itself, there is no separate normal stage |
+//! | `time_seg_s`, `time_hull_s` | segmentation; projection + α-shape + Douglas–Peucker |
+//! | `time_s` | every stage: segmentation + polygons + trimeshes + merging (also given one by one) |
+//! | `peak_rss_kib`, `rss_after_load_kib` | `VmHWM` of `/proc/self/status` at the end and after reading (`null` elsewhere) |
 
 use crate::input::InputArgs;
 use crate::map::{BackendChoice, save_patches};
@@ -19,7 +33,7 @@ use patch_core::{Isometry3, Patch, Point3, Real};
 use patch_extract::pipeline::{PipelineConfig, extract};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
-use serde_json::Value;
+use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -42,7 +56,7 @@ pub struct ExtractArgs {
     #[arg(required = true)]
     pub scans: Vec<PathBuf>,
     /// The map file to write.
-    #[arg(long, required_unless_present = "export")]
+    #[arg(long, required_unless_present_any = ["export", "jsonl", "polygons"])]
     pub out: Option<PathBuf>,
     /// The backend of the map file.
     #[arg(long, value_enum, default_value_t = BackendChoice::Bbox6d)]
@@ -65,6 +79,12 @@ pub struct ExtractArgs {
     /// Also write the patches, triangulated, as an OBJ mesh for any 3D viewer.
     #[arg(long)]
     pub export: Option<PathBuf>,
+    /// Append one JSON line (the peers' result format, kind `planes`) describing this run.
+    #[arg(long)]
+    pub jsonl: Option<PathBuf>,
+    /// Write the planar patches as the peers' plane-polygon JSON (world frame).
+    #[arg(long)]
+    pub polygons: Option<PathBuf>,
     #[command(flatten)]
     pub input: InputArgs,
 }
@@ -175,6 +195,7 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
         bail!("--export writes OBJ meshes; give a file ending in .obj");
     }
     let scans = read_scans(args, progress)?;
+    let rss_after_load = peak_rss_kib();
     let config = config(args);
     let bar = progress.bar(scans.len() as u64, "extracting");
     let result = extract(&scans, &config, |_| bar.inc(1))?;
@@ -223,6 +244,15 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
         write_export(export, &result.patches)?;
         writeln!(out, "wrote {}", export.display())?;
     }
+    if let Some(path) = &args.polygons {
+        write_polygons(path, &map_name(&args.scans), &result.patches)?;
+        writeln!(out, "wrote {}", path.display())?;
+    }
+    if let Some(path) = &args.jsonl {
+        let line = result_line(args, &config, &scans, &result, rss_after_load);
+        append_line(path, &line)?;
+        writeln!(out, "appended a result line to {}", path.display())?;
+    }
     if let Some(map) = &args.out {
         let (bytes, memory) = save_patches(result.patches, args.backend, args.spacing, map)?;
         writeln!(
@@ -234,4 +264,218 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     }
     progress.say(out.trim_end());
     Ok(())
+}
+
+/// The tool name and version of the result lines.
+fn tool_name() -> String {
+    format!("patchnav-{}", env!("CARGO_PKG_VERSION"))
+}
+
+/// The `map` of the result lines: the scan's file stem, or the stems joined by `+`.
+fn map_name(scans: &[PathBuf]) -> String {
+    let stems: Vec<String> = scans
+        .iter()
+        .map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default())
+        .collect();
+    stems.join("+")
+}
+
+/// The process's peak resident memory in KiB (`VmHWM`), where `/proc` has it.
+fn peak_rss_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+}
+
+/// A preset's name as the command line spells it.
+fn sensor_name(sensor: SensorPreset) -> &'static str {
+    match sensor {
+        SensorPreset::Alrf => "alrf",
+        SensorPreset::RangeCamera => "range-camera",
+        SensorPreset::Exact => "exact",
+    }
+}
+
+/// One result line (peers' FORMAT.md §4, kind `planes`) for this run.
+fn result_line(
+    args: &ExtractArgs,
+    config: &PipelineConfig,
+    scans: &[PointCloud],
+    result: &patch_extract::pipeline::Extraction,
+    rss_after_load: Option<u64>,
+) -> Value {
+    let sum = |f: fn(&patch_extract::pipeline::ScanReport) -> usize| -> usize {
+        result.scans.iter().map(f).sum()
+    };
+    let planar: Vec<&patch_core::PlanarPatch> =
+        result.patches.iter().filter_map(Patch::as_planar).collect();
+    let vertices: usize = planar.iter().map(|p| p.polygon().num_vertices()).sum();
+    let t = result.times;
+    let seg = &config.segment;
+    json!({
+        "kind": "planes",
+        "tool": tool_name(),
+        "method": if args.hybrid { "region-growing+hybrid" } else { "region-growing" },
+        "map": map_name(&args.scans),
+        "scans": scans.len(),
+        "points": sum(|r| r.points),
+        "organized": scans.iter().all(|s| s.grid().is_some()),
+        "planes": sum(|r| r.regions),
+        "inliers": sum(|r| r.region_points),
+        "polygons": planar.len(),
+        "polygon_vertices": vertices,
+        "failed_regions": sum(|r| r.failed_regions),
+        "trimesh_patches": result.patches.len() - planar.len(),
+        "merged_patches": result.merge.as_ref().map(|m| m.output),
+        "time_normals_s": null,
+        "time_seg_s": t.segmentation.as_secs_f64(),
+        "time_hull_s": t.polygonization.as_secs_f64(),
+        "time_trimesh_s": t.trimesh.as_secs_f64(),
+        "time_merge_s": t.merging.as_secs_f64(),
+        "time_s": t.total().as_secs_f64(),
+        "rss_after_load_kib": rss_after_load,
+        "peak_rss_kib": peak_rss_kib(),
+        "params": {
+            "sensor": sensor_name(args.sensor),
+            "merge": config.merge.is_some(),
+            "hybrid": args.hybrid,
+            "sigma_0": seg.noise.sigma_0,
+            "sigma_r2": seg.noise.sigma_r2,
+            "distance_factor": seg.distance_factor,
+            "min_inliers": seg.min_region_size,
+            "min_incidence_cos": seg.min_incidence_cos,
+            "k": seg.knn,
+            "knn_radius": seg.knn_radius,
+        },
+    })
+}
+
+/// Appends `line` and a newline to `path`, creating it if needed.
+fn append_line(path: &Path, line: &Value) -> Result<()> {
+    use std::io::Write as _;
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    writeln!(file, "{line}").with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// The planar patches as the peers' plane-polygon JSON (FORMAT.md §5): one plane per patch,
+/// `normal · p + d = 0`, its outer ring in `polygons` and its holes, if any, in `holes`.
+fn write_polygons(path: &Path, map: &str, patches: &[Patch]) -> Result<()> {
+    let ring = |pts: &[patch_core::Point2], p: &patch_core::PlanarPatch| -> Value {
+        pts.iter()
+            .map(|q| {
+                let w = p.to_world(q);
+                json!([w.x, w.y, w.z])
+            })
+            .collect()
+    };
+    let planes: Vec<Value> = patches
+        .iter()
+        .filter_map(Patch::as_planar)
+        .map(|p| {
+            let n = p.normal();
+            let polygon = p.polygon();
+            json!({
+                "normal": [n.x, n.y, n.z],
+                "d": -p.offset(),
+                "inliers": null,
+                "polygons": [ring(polygon.outer().points(), p)],
+                "holes": polygon.holes().iter().map(|h| ring(h.points(), p)).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let doc =
+        json!({"tool": tool_name(), "method": "region-growing", "map": map, "planes": planes});
+    std::fs::write(path, format!("{doc}\n"))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 m × 2 m wall 2 m in front of the sensor, 5 cm grid, unorganised.
+    fn wall(path: &Path) {
+        let points: Vec<Point3> = (0..41)
+            .flat_map(|i| {
+                (0..41).map(move |j| Point3::new(2.0, -1.0 + 0.05 * i as Real, 0.05 * j as Real))
+            })
+            .collect();
+        let cloud = PointCloud::from_positions(points).unwrap();
+        pointcloud::io::write_cloud(path, &cloud).unwrap();
+    }
+
+    #[test]
+    fn jsonl_lines_and_polygons_in_the_peers_format() {
+        let dir = tempfile::tempdir().unwrap();
+        let scan = dir.path().join("wall.ply");
+        wall(&scan);
+        let jsonl = dir.path().join("runs.jsonl");
+        let polygons = dir.path().join("wall.polygons.json");
+        let args = ExtractArgs {
+            scans: vec![scan],
+            out: None,
+            backend: BackendChoice::Bbox6d,
+            spacing: None,
+            sensor: SensorPreset::RangeCamera,
+            hybrid: false,
+            no_merge: false,
+            poses: None,
+            export: None,
+            jsonl: Some(jsonl.clone()),
+            polygons: Some(polygons.clone()),
+            input: InputArgs { skip_non_finite: false, depth_camera: None },
+        };
+        let progress = Progress::new(true);
+        run(&args, &progress).unwrap();
+        run(&args, &progress).unwrap();
+        let text = std::fs::read_to_string(&jsonl).unwrap();
+        assert_eq!(text.lines().count(), 2, "one appended line per run:\n{text}");
+        let row: Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+        for key in [
+            "tool",
+            "method",
+            "map",
+            "points",
+            "organized",
+            "planes",
+            "inliers",
+            "polygons",
+            "polygon_vertices",
+            "time_normals_s",
+            "time_seg_s",
+            "time_hull_s",
+            "time_s",
+            "peak_rss_kib",
+            "rss_after_load_kib",
+            "params",
+        ] {
+            assert!(row.get(key).is_some(), "no `{key}` in {row}");
+        }
+        assert_eq!(row["kind"], "planes");
+        assert_eq!(row["map"], "wall");
+        assert_eq!(row["points"], 41 * 41);
+        assert_eq!(row["planes"], 1);
+        assert_eq!(row["polygons"], 1);
+
+        let doc: Value =
+            serde_json::from_str(&std::fs::read_to_string(&polygons).unwrap()).unwrap();
+        let plane = &doc["planes"][0];
+        // n · p + d = 0 for the wall x = 2 (the normal faces the sensor at the origin).
+        let n: Vec<f64> =
+            plane["normal"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let d = plane["d"].as_f64().unwrap();
+        for v in plane["polygons"][0].as_array().unwrap() {
+            let p: Vec<f64> = v.as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
+            assert!((n[0] * p[0] + n[1] * p[1] + n[2] * p[2] + d).abs() < 1e-6);
+            assert!((p[0] - 2.0).abs() < 1e-6);
+        }
+    }
 }
