@@ -38,6 +38,12 @@ impl Progress {
         s
     }
 
+    /// Prints the result a command exists to print (an experiment's tables): unlike
+    /// [`Progress::say`], `--quiet` does not silence it.
+    pub fn report(&self, text: impl AsRef<str>) {
+        println!("{}", text.as_ref());
+    }
+
     /// Prints a summary line on standard output unless quiet.
     pub fn say(&self, line: impl AsRef<str>) {
         if !self.quiet {

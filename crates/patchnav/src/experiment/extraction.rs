@@ -340,7 +340,7 @@ pub fn run(args: &ExtractionArgs, progress: &Progress) -> Result<()> {
     storage_section(&mut out, &mut rows, &cases)?;
     map_size_section(&mut out, &mut rows, &setup, &scene, args.seed, progress)?;
     writeln!(out, "\nTotal time: {:.1} s", started.elapsed().as_secs_f64())?;
-    progress.say(out.trim_end());
+    progress.report(out.trim_end());
     if let Some(path) = &args.jsonl {
         let mut f = std::io::BufWriter::new(
             std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,

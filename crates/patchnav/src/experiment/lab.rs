@@ -403,7 +403,7 @@ pub fn run_timing(args: &LabTimingArgs, progress: &Progress) -> Result<()> {
     }
     let t0 = Instant::now();
     let lab = build_lab(a, progress)?;
-    progress.say(table_6_1(&lab, a)?);
+    progress.report(table_6_1(&lab, a)?);
     let cps = checkpoints(a.max_iterations, args.checkpoints);
     let bar =
         progress.bar(lab.maps.len() as u64 * lab.starts.len() as u64 * args.seeds, "rrt runs");
@@ -444,8 +444,8 @@ pub fn run_timing(args: &LabTimingArgs, progress: &Progress) -> Result<()> {
             .with_context(|| format!("writing {}", svg.display()))?;
         progress.say(format!("wrote {} and {}", csv.display(), svg.display()));
     }
-    progress.say(timing_table(&runs, &cps, &kinds, a, args.seeds * lab.starts.len() as u64)?);
-    progress.say(format!("total wall time {:.1} s", t0.elapsed().as_secs_f64()));
+    progress.report(timing_table(&runs, &cps, &kinds, a, args.seeds * lab.starts.len() as u64)?);
+    progress.report(format!("total wall time {:.1} s", t0.elapsed().as_secs_f64()));
     Ok(())
 }
 
@@ -679,7 +679,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     let prm_k = args.prm_iterations.unwrap_or(a.max_iterations);
     let t0 = Instant::now();
     let lab = build_lab(a, progress)?;
-    progress.say(table_6_1(&lab, a)?);
+    progress.report(table_6_1(&lab, a)?);
     let bounds: Vec<Aabb> = lab.maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
     let empty = VoxelGrid::covering(bounds, args.cells)?;
     let runs = lab.maps.len() as u64 * (lab.starts.len() as u64 * args.seeds + args.prm_seeds);
@@ -750,7 +750,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
          inflate them, spec §7.18); compare the percentages, not the volumes."
     )?;
     writeln!(out, "total wall time {:.1} s", t0.elapsed().as_secs_f64())?;
-    progress.say(out.trim_end());
+    progress.report(out.trim_end());
     Ok(())
 }
 

@@ -624,7 +624,7 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
         results.print_table(&mut out, spec)?;
     }
     out.push_str(&claims(&results));
-    progress.say(out.trim_end());
+    progress.report(out.trim_end());
     Ok(())
 }
 
