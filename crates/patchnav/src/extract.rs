@@ -1,5 +1,5 @@
 //! `patchnav extract SCANS... --out MAP [--backend B] [--sensor S] [--hybrid] [--no-merge]
-//! [--poses FILE] [--export FILE.obj] [--jsonl FILE] [--polygons FILE]`: planar patches (and, with `--hybrid`, trimesh patches
+//! [--poses FILE] [--export FILE.obj|ply] [--jsonl FILE] [--polygons FILE]`: planar patches (and, with `--hybrid`, trimesh patches
 //! for the non-planar remainder) from range scans, merged across scans, written as a map file
 //! of any patch backend (thesis §5.3, §6.1; `patch_extract::pipeline`).
 //!
@@ -76,7 +76,8 @@ pub struct ExtractArgs {
     /// A poses JSON overriding the scans' own poses.
     #[arg(long)]
     pub poses: Option<PathBuf>,
-    /// Also write the patches, triangulated, as an OBJ mesh for any 3D viewer.
+    /// Also write the patches, triangulated, as a mesh for any 3D viewer (`.obj`, or `.ply`:
+    /// binary PLY).
     #[arg(long)]
     pub export: Option<PathBuf>,
     /// Append one JSON line (the peers' result format, kind `planes`) describing this run.
@@ -171,7 +172,7 @@ fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<Vec<PointCloud>
     Ok(scans)
 }
 
-/// The patches as one OBJ mesh (planar patches triangulated).
+/// The patches as one OBJ or PLY mesh (planar patches triangulated).
 fn write_export(path: &Path, patches: &[Patch]) -> Result<()> {
     let mut vertices: Vec<Point3> = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();
@@ -190,9 +191,11 @@ fn write_export(path: &Path, patches: &[Patch]) -> Result<()> {
 /// Runs `patchnav extract`.
 pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     if let Some(export) = &args.export
-        && !export.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+        && !export
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("obj") || e.eq_ignore_ascii_case("ply"))
     {
-        bail!("--export writes OBJ meshes; give a file ending in .obj");
+        bail!("--export writes OBJ or PLY meshes; give a file ending in .obj or .ply");
     }
     let scans = read_scans(args, progress)?;
     let rss_after_load = peak_rss_kib();

@@ -58,6 +58,24 @@ fn scans_become_a_map_that_plans_and_an_obj_export() {
     assert!(info.status.success(), "{}", text(&info.stderr));
     assert!(text(&info.stdout).contains("bbox6d"), "{}", text(&info.stdout));
 
+    // A PLY export of the same patches: a binary mesh with as many faces as the OBJ.
+    let o = patchnav(&[
+        "--quiet",
+        "extract",
+        &scans[0],
+        &scans[1],
+        "--sensor",
+        "range-camera",
+        "--hybrid",
+        "--export",
+        &d("patches.ply"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let ply = std::fs::read(d("patches.ply")).unwrap();
+    let faces = obj.lines().filter(|l| l.starts_with("f ")).count();
+    let header = String::from_utf8_lossy(&ply[..ply.len().min(400)]).into_owned();
+    assert!(header.contains(&format!("element face {faces}\n")), "{header}");
+
     // Poses from the simulation's poses.json give the same patches as the files' own poses.
     let again = patchnav(&[
         "extract",

@@ -618,3 +618,41 @@ proptest! {
         let _ = read(&bytes);
     }
 }
+
+#[test]
+fn meshes_are_written_as_binary_ply_with_faces() {
+    use pointcloud::PolygonMesh;
+    let vertices = vec![
+        pointcloud::Point3::new(0.0, 0.0, 0.0),
+        pointcloud::Point3::new(1.0, 0.0, 0.0),
+        pointcloud::Point3::new(1.0, 1.0, 0.5),
+        pointcloud::Point3::new(0.0, 1.0, -0.25),
+    ];
+    let mesh = PolygonMesh::new(vertices.clone(), vec![vec![0, 1, 2], vec![0, 2, 3]]).unwrap();
+    let mut bytes = Vec::new();
+    pointcloud::io::ply::write_ply_mesh(&mut bytes, &mesh).unwrap();
+    let header_end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = std::str::from_utf8(&bytes[..header_end]).unwrap();
+    assert!(header.contains("element vertex 4\n") && header.contains("element face 2\n"));
+    assert!(header.contains("property list uchar uint vertex_indices\n"));
+    // 4 vertices of 3 doubles, then 2 faces of 1 count byte and 3 indices.
+    assert_eq!(bytes.len() - header_end, 4 * 24 + 2 * (1 + 12));
+    let face = &bytes[header_end + 96..header_end + 96 + 13];
+    assert_eq!(face[0], 3);
+    assert_eq!(u32::from_le_bytes(face[9..13].try_into().unwrap()), 2);
+    // Our reader takes the vertices as a cloud (faces are skipped).
+    let cloud = pointcloud::io::ply::read_ply(
+        std::io::Cursor::new(&bytes),
+        &pointcloud::io::ReadOptions::STRICT,
+    )
+    .unwrap();
+    assert_eq!(cloud.positions(), &vertices[..]);
+    // write_mesh picks the format by extension.
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["m.ply", "m.obj"] {
+        let path = dir.path().join(name);
+        pointcloud::io::write_mesh(&path, &mesh).unwrap();
+        let text = std::fs::read(&path).unwrap();
+        assert_eq!(text.starts_with(b"ply\n"), name.ends_with(".ply"));
+    }
+}

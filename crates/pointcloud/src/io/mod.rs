@@ -446,11 +446,18 @@ pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> 
     result.map_err(|e| e.with_path(path))
 }
 
-/// Writes `mesh` to the `.obj` file at `path` (see [`obj::write_obj`]); errors name `path`.
+/// Writes `mesh` to `path` as OBJ ([`obj::write_obj`]) or, for a `.ply` path, as a binary PLY
+/// mesh ([`ply::write_ply_mesh`]); errors name `path`.
 pub fn write_mesh(path: &Path, mesh: &crate::PolygonMesh) -> Result<(), Error> {
-    let format = Format::Obj;
+    let format =
+        if Format::from_path(path) == Some(Format::Ply) { Format::Ply } else { Format::Obj };
     let file = std::fs::File::create(path).map_err(|e| Error::new(format, e).with_path(path))?;
-    obj::write_obj(std::io::BufWriter::new(file), mesh).map_err(|e| e.with_path(path))
+    let writer = std::io::BufWriter::new(file);
+    match format {
+        Format::Ply => ply::write_ply_mesh(writer, mesh),
+        _ => obj::write_obj(writer, mesh),
+    }
+    .map_err(|e| e.with_path(path))
 }
 
 /// The format of `path`, or an [`ErrorKind::Unsupported`] error naming the extension.

@@ -166,6 +166,44 @@ pub fn write_ply(
     w.flush().map_err(io)
 }
 
+/// Writes `mesh` as a binary little-endian PLY mesh: `element vertex` with `double x, y, z`
+/// and `element face` with `list uchar uint vertex_indices` (every face of up to 255
+/// vertices; larger faces are fan-triangulated). Any PLY viewer opens it; [`read_ply`] reads
+/// its vertices as a cloud.
+pub fn write_ply_mesh(writer: impl Write, mesh: &crate::PolygonMesh) -> Result<(), Error> {
+    let io = |e: std::io::Error| Error::new(Format::Ply, e);
+    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(mesh.num_faces());
+    for face in mesh.faces() {
+        if face.len() <= usize::from(u8::MAX) {
+            faces.push(face.to_vec());
+        } else {
+            faces.extend((1..face.len() - 1).map(|k| vec![face[0], face[k], face[k + 1]]));
+        }
+    }
+    let mut w = BufWriter::new(writer);
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment written by patchnav\n\
+         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
+         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+        mesh.num_vertices(),
+        faces.len()
+    )
+    .map_err(io)?;
+    for p in mesh.vertices() {
+        for c in [p.x, p.y, p.z] {
+            w.write_all(&c.to_le_bytes()).map_err(io)?;
+        }
+    }
+    for face in &faces {
+        w.write_all(&[face.len() as u8]).map_err(io)?;
+        for &i in face {
+            w.write_all(&i.to_le_bytes()).map_err(io)?;
+        }
+    }
+    w.flush().map_err(io)
+}
+
 // ---------------------------------------------------------------------------------------------
 // Header
 
