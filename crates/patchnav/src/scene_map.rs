@@ -25,8 +25,11 @@ use patch_core::{
     FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch,
     Vector3,
 };
+use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
+use patch_extract::{PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes};
 use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
+use pointcloud::{BeamModel, PointCloud};
 use scene_sim::{Alrf, AlrfConfig, Cuboid, Cylinder, PlanarPolygon, RangeSensor, Scene, Shape};
 use std::collections::HashMap;
 use std::fmt;
@@ -264,8 +267,13 @@ pub fn build_map(
     backend: PatchBackend,
     t: &Tessellation,
     scans: &ScanSetup,
+    source: MapSource,
 ) -> Result<BuiltMap> {
-    let Some(patches) = surfaces.patches(kind, t)? else {
+    let patches = match source {
+        MapSource::Scene => surfaces.patches(kind, t)?,
+        MapSource::Scans => extracted_patches(&scan_clouds(scene, scans)?, kind)?,
+    };
+    let Some(patches) = patches else {
         let clouds = scan_points(scene, scans)?;
         let points: Vec<Point3> = clouds.into_iter().flatten().collect();
         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
@@ -319,6 +327,19 @@ pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
 /// # Errors
 /// A bad angular step, or fewer poses than asked for.
 pub fn scan_points(scene: &Scene, setup: &ScanSetup) -> Result<Vec<Vec<Point3>>> {
+    Ok(scan_clouds(scene, setup)?
+        .into_iter()
+        .map(|cloud| cloud.to_world().positions().to_vec())
+        .collect())
+}
+
+/// Simulated ALRF scans of `scene` from [`Scene::scan_poses`]: organised clouds in the sensor
+/// frame with their poses, the ±90° columns dropped (thesis App. A) — the input of patch
+/// extraction.
+///
+/// # Errors
+/// A bad angular step, or fewer poses than asked for.
+pub fn scan_clouds(scene: &Scene, setup: &ScanSetup) -> Result<Vec<PointCloud>> {
     let config = match setup.step_deg {
         None => AlrfConfig::sick_s300(),
         Some(step) => AlrfConfig::sick_s300_with_step(step.to_radians())
@@ -340,10 +361,56 @@ pub fn scan_points(scene: &Scene, setup: &ScanSetup) -> Result<Vec<Vec<Point3>>>
         .map(|(i, body)| {
             let seed = scene_sim::sensors::derive_seed(setup.seed, i as u64);
             let scan = alrf.scan(scene, &alrf.mount(body), seed);
-            let cloud = scan.to_cloud().context("building a scan's cloud")?.to_world();
-            Ok(cloud.positions().to_vec())
+            let cloud = scan.to_cloud().context("building a scan's cloud")?;
+            Ok(match scan.image.beams() {
+                BeamModel::ActuatedLrf(model) => {
+                    invalidate_alrf_side_columns(&cloud, model, &AlrfSideColumns::thesis())?.0
+                }
+                _ => cloud,
+            })
         })
         .collect()
+}
+
+/// Where the patches of the planes, hybrid and trimesh maps come from.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MapSource {
+    /// The scene's exact geometry.
+    Scene,
+    /// Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1):
+    /// planes = planar patches merged across scans, hybrid = planes + trimesh patches grown on
+    /// each scan's remainder, trimesh = whole scans meshed by trimesh growing (Algorithms 4, 5).
+    Scans,
+}
+
+/// The patches of map type `kind` extracted from `clouds` (see [`MapSource::Scans`]); `None`
+/// for the pc map.
+pub fn extracted_patches(clouds: &[PointCloud], kind: MapKind) -> Result<Option<Vec<Patch>>> {
+    let grow = TrimeshGrowConfig::alrf();
+    Ok(match kind {
+        MapKind::Planes => Some(extract(clouds, &PipelineConfig::alrf(), |_| {})?.patches),
+        MapKind::Hybrid => {
+            let config = PipelineConfig::alrf().with_remainder(grow);
+            Some(extract(clouds, &config, |_| {})?.patches)
+        }
+        MapKind::Trimesh => {
+            let mut patches = Vec::new();
+            for cloud in clouds {
+                let motion = cloud
+                    .sensor_pose()
+                    .map_or_else(Isometry3::identity, |pose| pose.world_from_sensor);
+                let grown = grow_trimeshes(cloud, &grow)?;
+                patches.extend(
+                    grown
+                        .into_patches()
+                        .into_iter()
+                        .map(|m| Patch::Trimesh(m.transformed(&motion))),
+                );
+            }
+            Some(patches)
+        }
+        MapKind::Pc => None,
+    })
 }
 
 /// The patch of a scene polygon. A hole touching the outline (a door reaching the floor) is

@@ -117,6 +117,8 @@ fn lab_timing_writes_a_row_per_checkpoint_and_a_plot_per_map() {
 fn lab_timing_runs_a_subset_of_maps_in_another_backend() {
     let mut args = vec!["experiment", "lab-timing", "--starts", "2", "--seeds", "1"];
     args.extend(["--max-iterations", "20", "--maps", "planes,hybrid", "--backend", "bbox6d"]);
+    // The maps from the scene's exact geometry instead of extraction from scans.
+    args.extend(["--source", "scene"]);
     args.extend(TOY_MAPS);
     let o = patchnav(&args);
     assert!(o.status.success(), "{}", stderr(&o));
