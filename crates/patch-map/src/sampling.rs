@@ -4,7 +4,7 @@
 //!
 //! # Guarantee
 //! Every triangle (trimesh triangles, and planar patches triangulated by
-//! [`triangulate_polygon`]) is sampled on the lattice `a + (i/n)(b − a) + (j/n)(c − a)`,
+//! [`triangulate_polygon`](crate::triangulate::triangulate_polygon)) is sampled on the lattice `a + (i/n)(b − a) + (j/n)(c − a)`,
 //! `i + j ≤ n`, with `n = ⌈longest edge / h⌉`. The lattice cuts the triangle into copies of it
 //! scaled by `1/n`, whose edges are at most `h`, and every point of a triangle is within its
 //! longest edge of each corner; so **every surface point is within `h` of a sample**, and every

@@ -162,7 +162,7 @@ const THESIS_TABLE_6_1: [(&str, &str, &str, &str, &str, &str); 4] = [
     ("pc", "54.0 MB", "–", "–", "29", "–"),
 ];
 
-/// The thesis's Table 6.2 (RRT, Lab, L6760–6772): volume [m³] and % not in planes, hybrid,
+/// The thesis's Table 6.2 (RRT, Lab, L6760–6772): volume (m³) and % not in planes, hybrid,
 /// trimesh, pc.
 const THESIS_TABLE_6_2_RRT: [(&str, f64, [Option<f64>; 4]); 4] = [
     ("planes", 9714.015, [None, Some(0.557), Some(1.739), Some(0.986)]),
