@@ -8,9 +8,9 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, LazyPrm, MaPrm, MaPrmConfig, MaRrt,
-    MaRrtConfig, MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt,
-    RrtConfig, RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
+    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
+    MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
+    RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -230,7 +230,7 @@ pub(crate) fn make_planner(
             let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
             Box::new(Prm::new(map, space, config, seed))
         }
-        PlannerChoice::LazyPrm => Box::new(LazyPrm::new(map, space, prm_config(), seed)),
+        PlannerChoice::LazyPrm => Box::new(Prm::lazy(map, space, prm_config(), seed)),
         PlannerChoice::RrtStar => {
             let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
             Box::new(RrtStar::new(map, space, config, seed))

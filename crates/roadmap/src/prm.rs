@@ -95,13 +95,26 @@ pub struct Prm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
     space: PlanningSpace,
     config: PrmConfig,
     seed: u64,
+    /// The lazy PRM ([`LazyPrm`]) instead of the eager one.
+    lazy: bool,
     solution: Solution,
 }
 
 impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> Self {
-        Prm { map, space, config, seed, solution: Solution::default() }
+        Prm { map, space, config, seed, lazy: false, solution: Solution::default() }
+    }
+
+    /// The lazy PRM (see [`LazyPrm`]) on `map` in `space`; with the same seed its samples are
+    /// those of [`Prm::new`].
+    pub fn lazy(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> LazyPrm<'m, M> {
+        Prm { map, space, config, seed, lazy: true, solution: Solution::default() }
+    }
+
+    /// Whether this is the lazy PRM.
+    pub fn is_lazy(&self) -> bool {
+        self.lazy
     }
 
     /// The configuration.
@@ -117,14 +130,19 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> {
     fn name(&self) -> &'static str {
-        if self.config.star { "prm-star" } else { "prm" }
+        match (self.lazy, self.config.star) {
+            (false, false) => "prm",
+            (false, true) => "prm-star",
+            (true, false) => "lazy-prm",
+            (true, true) => "lazy-prm-star",
+        }
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
         let space = &self.space;
         let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
         let solution = &mut self.solution;
-        let lazy = false;
+        let lazy = self.lazy;
         solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
     }
 
@@ -147,7 +165,8 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
 
 /// Lazy PRM (Bohlin & Kavraki 2000, "Path planning using lazy PRM"): the PRM's roadmap is
 /// built without collision checks, and only the edges of candidate paths are checked; not part
-/// of the thesis.
+/// of the thesis. A [`Prm`] made by [`Prm::lazy`] (one type, so the eager and the lazy PRM
+/// share everything but the edge checks).
 ///
 /// Each iteration draws a uniform sample, adds it, and joins it by *unchecked* edges to its
 /// `N` nearest existing vertices ([`PrmConfig::neighbours`]; with [`PrmConfig::star`] the
@@ -195,61 +214,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
 /// optimistic graph (`O(E log V)`) per deleted edge, at most one capsule check per Unknown
 /// edge of the path found, and a union–find rebuild (`O(E α(V))`) when an edge is deleted;
 /// failed rounds happen at most once per tenth of growth. Every edge is checked at most once.
-pub struct LazyPrm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
-    map: &'m M,
-    space: PlanningSpace,
-    config: PrmConfig,
-    seed: u64,
-    solution: Solution,
-}
-
-impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> LazyPrm<'m, M> {
-    /// A planner on `map` in `space`; `seed` fixes the random stream (with the same seed the
-    /// samples are those of the [`Prm`]).
-    pub fn new(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> Self {
-        LazyPrm { map, space, config, seed, solution: Solution::default() }
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &PrmConfig {
-        &self.config
-    }
-
-    /// The space.
-    pub fn space(&self) -> &PlanningSpace {
-        &self.space
-    }
-}
-
-impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for LazyPrm<'_, M> {
-    fn name(&self) -> &'static str {
-        if self.config.star { "lazy-prm-star" } else { "lazy-prm" }
-    }
-
-    fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
-        let space = &self.space;
-        let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
-        let solution = &mut self.solution;
-        let lazy = true;
-        solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
-    }
-
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
-}
+pub type LazyPrm<'m, M> = Prm<'m, M>;
 
 /// The PRM's working state besides the roadmap.
 struct Forest {

@@ -8,7 +8,7 @@ use patch_core::{
 };
 use proptest::prelude::*;
 use roadmap::{
-    Goal, LazyPrm, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
+    Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
 };
 
 mod common;
@@ -20,7 +20,7 @@ fn finds_the_door_through_checked_edges() {
     let problem = across(0.3);
     for config in [PrmConfig::thesis(), PrmConfig::star()] {
         for seed in 0..3 {
-            let mut p = LazyPrm::new(&map, space(0.5), config, seed);
+            let mut p = Prm::lazy(&map, space(0.5), config, seed);
             assert_eq!(p.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
             assert_all_free(&map, &p, 1);
             let path = p.path_to(0).unwrap();
@@ -42,7 +42,7 @@ fn lazy_checks_fewer_edges_than_eager() {
     let problem = across(0.3);
     for seed in 0..4 {
         let mut eager = Prm::new(&map, space(0.5), PrmConfig::thesis(), seed);
-        let mut lazy = LazyPrm::new(&map, space(0.5), PrmConfig::thesis(), seed);
+        let mut lazy = Prm::lazy(&map, space(0.5), PrmConfig::thesis(), seed);
         assert_eq!(eager.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
         assert_eq!(lazy.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
         let (e, l) = (eager.counters(), lazy.counters());
@@ -62,7 +62,7 @@ fn lazy_checks_fewer_edges_than_eager() {
 fn same_seed_same_roadmap_and_counters_match_a_counted_map() {
     let counted = Counted::new(wall_with_door());
     let problem = across(0.3);
-    let mut a = LazyPrm::new(&counted, space(0.5), PrmConfig::thesis(), 7);
+    let mut a = Prm::lazy(&counted, space(0.5), PrmConfig::thesis(), 7);
     a.solve(&problem, &mut MaxIterations(400));
     assert_eq!(a.counters().collision_checks, counted.counts().is_step_free);
     assert_eq!(a.counters().samples, 400);
@@ -71,11 +71,11 @@ fn same_seed_same_roadmap_and_counters_match_a_counted_map() {
     let first = a.roadmap().clone();
     a.solve(&problem, &mut MaxIterations(400));
     assert!(same_roadmap(&first, a.roadmap()), "a second solve repeats the first");
-    let mut b = LazyPrm::new(&counted, space(0.5), PrmConfig::thesis(), 7);
+    let mut b = Prm::lazy(&counted, space(0.5), PrmConfig::thesis(), 7);
     b.solve(&problem, &mut MaxIterations(400));
     assert!(same_roadmap(a.roadmap(), b.roadmap()));
     assert_eq!(a.path_to(0), b.path_to(0));
-    let mut c = LazyPrm::new(&counted, space(0.5), PrmConfig::thesis(), 8);
+    let mut c = Prm::lazy(&counted, space(0.5), PrmConfig::thesis(), 8);
     c.solve(&problem, &mut MaxIterations(400));
     assert!(!same_roadmap(a.roadmap(), c.roadmap()));
     assert_eq!(a.name(), "lazy-prm");
@@ -90,7 +90,7 @@ fn an_open_room_needs_only_the_path_edges() {
     // and goal checks).
     let map = BruteForceMap::new();
     let problem = across(0.3);
-    let mut p = LazyPrm::new(&map, space(0.5), PrmConfig::thesis(), 1);
+    let mut p = Prm::lazy(&map, space(0.5), PrmConfig::thesis(), 1);
     assert_eq!(p.solve(&problem, &mut until_solved(5_000)), PlannerStatus::Exact);
     let path = p.path_to(0).unwrap();
     assert_eq!(p.counters().collision_checks, 2 + (path.len() as u64 - 1));
@@ -102,7 +102,7 @@ fn invalid_starts_and_goals() {
     let map = wall_with_door();
     let goal = Goal { center: Point3::new(5.0, 2.0, 1.25), tolerance: 0.3 };
     let near_wall = Point3::new(2.9, 3.0, 1.25);
-    let mut p = LazyPrm::new(&map, space(0.5), PrmConfig::thesis(), 0);
+    let mut p = Prm::lazy(&map, space(0.5), PrmConfig::thesis(), 0);
     let problem = Problem { start: near_wall, goals: vec![goal] };
     assert_eq!(p.solve(&problem, &mut MaxIterations(10)), PlannerStatus::InvalidStart);
     let problem = Problem {
@@ -131,7 +131,7 @@ proptest! {
         let problem = Problem { start, goals: goals.clone() };
         let base = if star { PrmConfig::star() } else { PrmConfig::thesis() };
         let config = PrmConfig { direct_goal_step, ..base };
-        let mut p = LazyPrm::new(&map, space, config, seed);
+        let mut p = Prm::lazy(&map, space, config, seed);
         let status = p.solve(&problem, &mut MaxIterations(80));
         assert_all_free(&map, &p, goals.len());
         let sphere_free = |q: Point3| map.is_step_free(&CapsuleStep::sphere(q, RADIUS).unwrap());
