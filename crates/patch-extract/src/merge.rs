@@ -292,11 +292,45 @@ fn unite<'a>(group: impl Iterator<Item = &'a PlanarPatch> + Clone) -> Option<Vec
         .iter()
         .map(|poly| {
             let outer = ring_from_geo(poly.exterior());
-            let holes = poly.interiors().iter().map(ring_from_geo).collect();
-            let polygon = Polygon::new(outer, holes).ok()?;
-            PlanarPatch::new(polygon, frame).ok()
+            let holes: Vec<Vec<Point2>> = poly.interiors().iter().map(ring_from_geo).collect();
+            let polygon = Polygon::new(outer.clone(), holes.clone()).or_else(|_| {
+                let mut rings: Vec<Vec<Point2>> = std::iter::once(outer).chain(holes).collect();
+                separate_pinches(&mut rings);
+                let outer = rings.remove(0);
+                Polygon::new(outer, rings)
+            });
+            PlanarPatch::new(polygon.ok()?, frame).ok()
         })
         .collect()
+}
+
+/// Moves every repeated occurrence of a vertex (a ring touching itself or another ring at a
+/// point, which a union can produce and patch polygons refuse) by a nanometre-scale step
+/// toward the midpoint of its two ring neighbours, so the rings no longer touch. The area
+/// changes by about the square of the step; no point farther than the step from the boundary
+/// changes side.
+fn separate_pinches(rings: &mut [Vec<Point2>]) {
+    let scale =
+        rings.iter().flatten().fold(0.0, |m: Real, p| m.max(p.x.abs()).max(p.y.abs())).max(1.0);
+    let step = 1e-9 * scale;
+    let mut seen: Vec<Point2> = Vec::new();
+    for ring in rings.iter_mut() {
+        let n = ring.len();
+        for i in 0..n {
+            let v = ring[i];
+            if seen.contains(&v) {
+                let mid =
+                    Point2::from((ring[(i + n - 1) % n].coords + ring[(i + 1) % n].coords) / 2.0);
+                let d = mid - v;
+                let len = d.norm();
+                if len > 0.0 {
+                    ring[i] = v + d * (step / len);
+                }
+            } else {
+                seen.push(v);
+            }
+        }
+    }
 }
 
 /// The area centroid of a patch's outer ring, in world coordinates.

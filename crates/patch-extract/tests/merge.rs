@@ -170,3 +170,19 @@ proptest! {
         }
     }
 }
+
+/// Four rectangles around a unit cell whose union has a hole touching the outline at one
+/// vertex (a case a random search found): merged without overlap, with the exact area.
+#[test]
+fn a_hole_pinched_to_the_outline_is_separated() {
+    let cells = [(0, 4, 2, 3), (3, 5, 1, 2), (1, 6, 2, 1), (1, 3, 2, 2)];
+    let patches: Vec<PlanarPatch> = cells
+        .iter()
+        .map(|&(x, y, w, h)| rect(x as Real, y as Real, (x + w) as Real, (y + h) as Real, 0.5, 0.0))
+        .collect();
+    let (out, stats) = merge_coplanar(&patches, &MergeConfig::exact()).unwrap();
+    assert_eq!(stats.kept_unmerged, 0, "{stats:?}");
+    assert_eq!(out.len(), 1);
+    assert_eq!(out[0].polygon().holes().len(), 1, "the enclosed cell stays a hole");
+    assert!((total_area(&out) - 12.0).abs() < 1e-6, "{}", total_area(&out));
+}
