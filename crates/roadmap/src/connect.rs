@@ -9,7 +9,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
+use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
 
@@ -64,21 +64,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for RrtConnect<
         solve_connect(self.map, &self.space, self.seed, problem, stop, &mut self.solution)
     }
 
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
+    planner::solution_accessors!();
 }
 
 /// One tree: its vertices (by nearest-neighbour index) and their nearest-neighbour structure.

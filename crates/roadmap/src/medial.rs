@@ -18,7 +18,7 @@ use patch_core::{
 };
 use rand_chacha::ChaCha8Rng;
 
-use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
+use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
 use crate::prm::{PrmConfig, solve_prm};
 use crate::rrt::{RrtConfig, solve_rrt};
 use crate::space::{PlanningSpace, Problem};
@@ -130,7 +130,7 @@ fn retract(
 }
 
 /// Closest-patch queries through the map, counted and timed (for
-/// [`PlannerCounters::proximity_queries`]).
+/// [`PlannerCounters::proximity_queries`](crate::PlannerCounters::proximity_queries)).
 struct ProximityCounter<'a, M: ?Sized> {
     map: &'a M,
     queries: Cell<u64>,
@@ -193,15 +193,15 @@ impl MaPrmConfig {
 ///
 /// Each iteration draws a uniform sample and retracts it with [`retract_to_medial_axis`]; a
 /// dropped sample adds nothing but still counts as an iteration (and in
-/// [`PlannerCounters::samples`]). A retracted sample is connected exactly as in the PRM: its
+/// [`PlannerCounters::samples`](crate::PlannerCounters::samples)). A retracted sample is connected exactly as in the PRM: its
 /// `N` nearest existing vertices (computed before adding it) are tried by increasing
 /// distance, skipping those already in its component (union–find), and an edge is added if
 /// the robot's capsule is free. The start (vertex 0) and, with the direct goal step, goal
 /// centres are not retracted.
 ///
 /// With the same seed, the samples before retraction are those of the [`Prm`](crate::Prm).
-/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`] (not in
-/// [`PlannerCounters::collision_checks`]).
+/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`](crate::PlannerCounters::proximity_queries) (not in
+/// [`PlannerCounters::collision_checks`](crate::PlannerCounters::collision_checks)).
 ///
 /// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) is rejected at
@@ -280,21 +280,7 @@ impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planne
         status
     }
 
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
+    planner::solution_accessors!();
 }
 
 /// The choices of an [`MaRrt`]. No `Default`: pick [`MaRrtConfig::for_space`] and change
@@ -329,8 +315,8 @@ impl MaRrtConfig {
 /// `x_new` is inside the bounds). Only `x′` lies on the medial axis; `x_new` does when the
 /// step reaches it. Goals are tested as in the RRT.
 ///
-/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`] (not in
-/// [`PlannerCounters::collision_checks`]).
+/// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`](crate::PlannerCounters::proximity_queries) (not in
+/// [`PlannerCounters::collision_checks`](crate::PlannerCounters::collision_checks)).
 ///
 /// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) cannot run it.
@@ -380,21 +366,7 @@ impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planne
         status
     }
 
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
+    planner::solution_accessors!();
 }
 
 #[cfg(test)]

@@ -173,6 +173,29 @@ where
     None
 }
 
+/// The [`Planner`] methods of a planner whose state is a `solution: Solution` field:
+/// `roadmap`, `path_to`, `counters` and `clear`.
+macro_rules! solution_accessors {
+    () => {
+        fn roadmap(&self) -> &$crate::Roadmap {
+            &self.solution.graph
+        }
+
+        fn path_to(&self, goal: usize) -> Option<Vec<patch_core::Point3>> {
+            self.solution.path_to(goal)
+        }
+
+        fn counters(&self) -> $crate::PlannerCounters {
+            self.solution.counters
+        }
+
+        fn clear(&mut self) {
+            self.solution = $crate::planner::Solution::default();
+        }
+    };
+}
+pub(crate) use solution_accessors;
+
 /// The shared state of a solve: the roadmap, which vertex reached each goal, the counters.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Solution {

@@ -12,7 +12,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
+use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
 
@@ -146,21 +146,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
         solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
     }
 
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
+    planner::solution_accessors!();
 }
 
 /// Lazy PRM (Bohlin & Kavraki 2000, "Path planning using lazy PRM"): the PRM's roadmap is
@@ -204,7 +190,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
 /// at once, as in the [`Prm`].
 ///
 /// [`Planner::roadmap`] holds every vertex but only the edges checked free (the roadmap's
-/// contract: an edge is a motion found free), so [`PlannerCounters::edges`] counts those;
+/// contract: an edge is a motion found free), so [`PlannerCounters::edges`](crate::PlannerCounters::edges) counts those;
 /// [`Planner::path_to`] returns the shortest path over them.
 ///
 /// Needs only [`UnspecificStepIntersector<CapsuleStep>`].

@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
+use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
 
@@ -121,21 +121,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
         solve_rrt(map, space, config, self.seed, problem, stop, solution, Some, extend)
     }
 
-    fn roadmap(&self) -> &Roadmap {
-        &self.solution.graph
-    }
-
-    fn path_to(&self, goal: usize) -> Option<Vec<Point3>> {
-        self.solution.path_to(goal)
-    }
-
-    fn counters(&self) -> PlannerCounters {
-        self.solution.counters
-    }
-
-    fn clear(&mut self) {
-        self.solution = Solution::default();
-    }
+    planner::solution_accessors!();
 }
 
 /// The RRT loop shared by [`Rrt`], the Evasion RRT and the MA RRT: `retract(x)` maps each
