@@ -30,6 +30,8 @@ mod problem;
 mod progress;
 mod scene_map;
 mod simulate;
+mod terrain;
+mod tof;
 
 /// Turns 3D range data into maps a robot can plan on.
 #[derive(Parser, Debug)]
@@ -72,6 +74,11 @@ enum Command {
     /// Run the thesis's planning experiments and print our numbers beside the thesis's.
     #[command(subcommand)]
     Experiment(experiment::ExperimentCommand),
+    /// Time-of-flight frames: filter wrap-around (AAT), unwrap, calibrate, simulate.
+    #[command(subcommand)]
+    Tof(tof::TofCommand),
+    /// Classify the terrain ahead in a range frame (plane Hough transform, thesis Ch. 4).
+    Terrain(terrain::TerrainArgs),
 }
 
 fn main() -> ExitCode {
@@ -87,6 +94,8 @@ fn main() -> ExitCode {
         Command::Map(command) => map::run(&command, &progress),
         Command::Plan(args) => plan::run(&args, &progress),
         Command::Experiment(command) => experiment::run(&command, &progress),
+        Command::Tof(command) => tof::run(&command, &progress),
+        Command::Terrain(args) => terrain::run(&args, &progress),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,1 @@
+//! Plane Hough transform for terrain classification (thesis Ch. 4) (being written).
