@@ -286,13 +286,21 @@ impl FilterOutput {
         points: &mut Vec<[f32; 3]>,
         pixels: &mut Vec<u32>,
     ) {
-        for (i, (&o, &r)) in self.outcomes.iter().zip(&self.radial).enumerate() {
-            if o.is_output() {
-                let d = tables.unit[i];
-                points.push([d[0] * r, d[1] * r, d[2] * r]);
-                pixels.push(i as u32);
-            }
+        let n = self.outcomes.len().min(tables.unit.len());
+        let (p0, q0) = (points.len(), pixels.len());
+        points.resize(p0 + n, [0.0; 3]);
+        pixels.resize(q0 + n, 0);
+        let (pts, pix) = (&mut points[p0..], &mut pixels[q0..]);
+        // Write every pixel, advance only past output ones (no unpredictable branch).
+        let mut j = 0;
+        for i in 0..n {
+            let (d, r) = (tables.unit[i], self.radial[i]);
+            pts[j] = [d[0] * r, d[1] * r, d[2] * r];
+            pix[j] = i as u32;
+            j += self.outcomes[i].is_output() as usize;
         }
+        points.truncate(p0 + j);
+        pixels.truncate(q0 + j);
     }
 
     /// The point cloud of the output: every non-dropped pixel (or every measured pixel when
@@ -378,6 +386,8 @@ pub struct TofFilter {
     /// AAT with the radial range (else depth, else the AT / none).
     mode: Mode,
     non_ambiguity: f32,
+    /// A table of ones (radial input needs no conversion).
+    ones: Vec<f32>,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -456,6 +466,7 @@ impl TofFilter {
             limit,
             mode,
             non_ambiguity: camera.non_ambiguity_range() as f32,
+            ones: vec![1.0; n],
         })
     }
 
@@ -495,41 +506,83 @@ impl TofFilter {
         }
         let n = self.camera.num_pixels();
         out.reset(n);
-        let depth_input = self.kind == RangeKind::Depth;
-        let low_at = self.config.unwrap.map(|u| u.low_at.map_or(f32::NEG_INFINITY, |t| t as f32));
-        let mut counts = OutcomeCounts::default();
+        // No unwrapping: no flagged pixel passes `a > +∞`; unwrapping without a low AT: all do.
+        let low = self
+            .config
+            .unwrap
+            .map_or(f32::INFINITY, |u| u.low_at.map_or(f32::NEG_INFINITY, |t| t as f32));
         let (range, amplitude) = (frame.range(), frame.amplitude());
-        for i in 0..n {
-            let r = range[i];
-            if r <= 0.0 {
-                counts.dropped += 1;
-                continue;
+        let limit = &self.limit[..n];
+        // One branch-free loop per test, so the per-pixel decision compiles to selects.
+        let counts = match (self.mode, self.kind) {
+            (Mode::None, _) => self.decide(range, amplitude, low, out, |_, _, _| true),
+            (Mode::At, _) => self.decide(range, amplitude, low, out, |i, a, _| a > limit[i]),
+            (Mode::AatDepth, RangeKind::Depth) => {
+                self.decide(range, amplitude, low, out, |i, a, r| a * r * r > limit[i])
             }
-            let k = self.tables.radial_per_depth[i];
-            let (radial, depth) = if depth_input { (r * k, r) } else { (r, r / k) };
-            let a = amplitude[i];
-            let valid = match self.mode {
-                Mode::None => true,
-                Mode::At => a > self.limit[i],
-                Mode::AatDepth => a * depth * depth > self.limit[i],
-                Mode::AatRadial => a * radial * radial > self.limit[i],
-            };
-            if valid {
-                out.outcomes[i] = PixelOutcome::Kept;
-                out.radial[i] = radial;
-                counts.kept += 1;
-            } else if let Some(low) = low_at
-                && a > low
-            {
-                out.outcomes[i] = PixelOutcome::Unwrapped;
-                out.radial[i] = radial + self.non_ambiguity;
-                counts.unwrapped += 1;
-            } else {
-                counts.dropped += 1;
+            (Mode::AatRadial, RangeKind::Radial) => {
+                self.decide(range, amplitude, low, out, |i, a, r| a * r * r > limit[i])
             }
-        }
+            // The test wants the other kind of range than the frame holds: convert per pixel.
+            (Mode::AatDepth, RangeKind::Radial) => {
+                let k = &self.tables.radial_per_depth[..n];
+                self.decide(range, amplitude, low, out, |i, a, r| {
+                    let z = r / k[i];
+                    a * z * z > limit[i]
+                })
+            }
+            (Mode::AatRadial, RangeKind::Depth) => {
+                let k = &self.tables.radial_per_depth[..n];
+                self.decide(range, amplitude, low, out, |i, a, r| {
+                    let q = r * k[i];
+                    a * q * q > limit[i]
+                })
+            }
+        };
         out.counts = counts;
         Ok(())
+    }
+
+    /// The per-pixel loop: `valid(i, amplitude, reported range)` is the detector. Writes the
+    /// outcome and output radial range of every pixel and returns the counts.
+    #[inline(always)]
+    fn decide(
+        &self,
+        range: &[f32],
+        amplitude: &[f32],
+        low: f32,
+        out: &mut FilterOutput,
+        valid: impl Fn(usize, f32, f32) -> bool,
+    ) -> OutcomeCounts {
+        let n = range.len();
+        let to_radial = if self.kind == RangeKind::Depth {
+            &self.tables.radial_per_depth[..n]
+        } else {
+            &self.ones[..n]
+        };
+        let (outcomes, radial_out) = (&mut out.outcomes[..n], &mut out.radial[..n]);
+        let amplitude = &amplitude[..n];
+        let (mut kept, mut unwrapped) = (0u32, 0u32);
+        for i in 0..n {
+            let (r, a) = (range[i], amplitude[i]);
+            // Integer arithmetic instead of branches: the decisions are data-dependent.
+            let measured = (r > 0.0) as u8;
+            let ok = valid(i, a, r) as u8;
+            let keep = measured & ok;
+            let unwrap = measured & (1 - ok) & ((a > low) as u8);
+            let radial =
+                (r * to_radial[i] + self.non_ambiguity * unwrap as f32) * ((keep | unwrap) as f32);
+            radial_out[i] = radial;
+            outcomes[i] = match 2 - 2 * keep - unwrap {
+                0 => PixelOutcome::Kept,
+                1 => PixelOutcome::Unwrapped,
+                _ => PixelOutcome::Dropped,
+            };
+            kept += keep as u32;
+            unwrapped += unwrap as u32;
+        }
+        let (kept, unwrapped) = (kept as usize, unwrapped as usize);
+        OutcomeCounts { kept, unwrapped, dropped: n - kept - unwrapped }
     }
 
     /// [`TofFilter::apply`] into a new output.
@@ -586,6 +639,7 @@ pub fn illumination_table(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pointcloud::PinholeIntrinsics;
 
     fn camera() -> TofCamera {
         TofCamera::sr3000()
@@ -709,6 +763,93 @@ mod tests {
         assert_eq!(a.outcomes, b.outcomes);
         for (x, y) in a.radial.iter().zip(&b.radial) {
             assert!((x - y).abs() < 1e-4);
+        }
+    }
+
+    /// Eq 2.4 and the unwrapping rule evaluated literally in f64, pixel by pixel: the oracle of
+    /// the branch-free loop.
+    fn reference(frame: &TofFrame, cfg: &FilterConfig) -> Vec<(PixelOutcome, Real)> {
+        let c = frame.camera();
+        let aw = match &cfg.detector {
+            Detector::Aat(a) => illumination_table(&a.illumination, c).unwrap(),
+            _ => vec![0.0; c.num_pixels()],
+        };
+        (0..c.num_pixels())
+            .map(|i| {
+                let a = frame.amplitude()[i] as Real;
+                if frame.range()[i] <= 0.0 {
+                    return (PixelOutcome::Dropped, 0.0);
+                }
+                let valid = match &cfg.detector {
+                    Detector::None => true,
+                    Detector::At(t) => a > *t,
+                    Detector::Aat(x) => {
+                        let r = match x.range {
+                            AatRange::Depth => frame.depth(i),
+                            AatRange::Radial => frame.radial(i),
+                        };
+                        let w = match x.negative {
+                            NegativeIllumination::Literal => aw[i],
+                            NegativeIllumination::Clamp(m) => aw[i].max(m),
+                        };
+                        a > w * x.threshold / (r * r)
+                    }
+                };
+                if valid {
+                    (PixelOutcome::Kept, frame.radial(i))
+                } else if let Some(u) = cfg.unwrap
+                    && u.low_at.is_none_or(|t| a > t)
+                {
+                    (PixelOutcome::Unwrapped, frame.radial(i) + c.non_ambiguity_range())
+                } else {
+                    (PixelOutcome::Dropped, 0.0)
+                }
+            })
+            .collect()
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn fast_filter_matches_the_literal_rule(
+            seed in 0u64..1000,
+            radial_input in proptest::bool::ANY,
+            radial_test in proptest::bool::ANY,
+            clamp in proptest::bool::ANY,
+            unwrap in 0u8..3,
+            at in proptest::option::of(0.0..400.0f64),
+        ) {
+            use rand::{Rng, SeedableRng};
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let c = TofCamera::pinhole(17, 13, PinholeIntrinsics { fx: 8.0, fy: 8.0, cx: 8.0, cy: 6.0 }, 20e6).unwrap();
+            let n = c.num_pixels();
+            let range: Vec<f32> =
+                (0..n).map(|_| if rng.random_bool(0.1) { 0.0 } else { rng.random_range(0.05..7.5f32) }).collect();
+            let amp: Vec<f32> = (0..n).map(|_| rng.random_range(0.0..3000.0f32)).collect();
+            let kind = if radial_input { RangeKind::Radial } else { RangeKind::Depth };
+            let frame = TofFrame::new(c, kind, range, amp).unwrap();
+            let cfg = match at {
+                Some(t) => FilterConfig::at(t),
+                None => {
+                    let mut a = AatConfig::sr3000();
+                    a.illumination = Illumination::Parabola(Parabola { a_hat: 150.0, delta_x: 8.0, delta_y: 4.0, curvature: 1.0 });
+                    a.range = if radial_test { AatRange::Radial } else { AatRange::Depth };
+                    if clamp { a.negative = NegativeIllumination::Clamp(5.0) }
+                    let low = match unwrap { 0 => None, 1 => Some(None), _ => Some(Some(100.0)) };
+                    FilterConfig { detector: Detector::Aat(a), unwrap: low.map(|low_at| UnwrapConfig { low_at }) }
+                }
+            };
+            let out = TofFilter::new(&c, kind, &cfg).unwrap().run(&frame).unwrap();
+            let want = reference(&frame, &cfg);
+            let mut differ = 0;
+            for (i, (o, r)) in want.iter().enumerate() {
+                if out.outcomes[i] != *o {
+                    differ += 1; // a tie within f32 rounding may go either way
+                } else {
+                    proptest::prop_assert!((out.radial[i] as Real - r).abs() < 1e-4 * (1.0 + r), "pixel {}", i);
+                }
+            }
+            proptest::prop_assert!(differ <= 1, "{} of {} outcomes differ", differ, n);
+            proptest::prop_assert_eq!(out.counts, OutcomeCounts::of(&out.outcomes));
         }
     }
 }
