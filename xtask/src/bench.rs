@@ -57,6 +57,8 @@ pub fn run(args: &[String]) -> Result<()> {
     }
     cmd.arg("--seed").arg(args.seed.to_string()).args(&args.names);
     let provenance = crate::provenance::collect(args.seed);
+    // Benchmarks print their tables (thesis beside ours) on standard error: show them.
+    cmd.stderr(std::process::Stdio::inherit());
     let stdout = crate::capture(&mut cmd)?;
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

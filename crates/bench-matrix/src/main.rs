@@ -36,6 +36,12 @@ const BENCHES: &[Bench] = &[
         about: "write and read a full ALRF scan in PLY (binary, ascii), PCD (binary, compressed), XYZ",
         run: io,
     },
+    Bench {
+        name: "tof",
+        about: "Table 2.4: AT 160/240, AAT, AAT+unwrap, two-frequency, AAT+unwrap+spatial on six simulated \
+                scenes and a folded real frame; AAT speed",
+        run: tof,
+    },
 ];
 
 fn main() {
@@ -183,5 +189,131 @@ fn io(seed: u64) -> Result<Vec<Value>> {
             }));
         }
     }
+    Ok(rows)
+}
+
+/// The shared data folder (`$PATCHNAV_REAL_DATA`, else `shared/data/real` next to the checkout).
+fn real_data_dir() -> Option<std::path::PathBuf> {
+    let dir = match std::env::var_os("PATCHNAV_REAL_DATA") {
+        Some(d) => std::path::PathBuf::from(d),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real"),
+    };
+    dir.is_dir().then_some(dir)
+}
+
+fn tof(seed: u64) -> Result<Vec<Value>> {
+    use sensor_tof::experiment::{Method, evaluate_folded, evaluate_scene, quality_table, table_2_4};
+    let mut rows = Vec::new();
+    let mut results = Vec::new();
+    for scene in sensor_tof::scenes::all_scenes()? {
+        let r = evaluate_scene(&scene, &Method::all(), seed)?;
+        for m in &r.results {
+            let q = &m.score;
+            for (metric, value, unit) in [
+                ("discarded", q.discarded_percent, "%"),
+                ("wrong_kept", q.wrong_kept_percent, "%"),
+                ("wrapped_kept", q.wrapped_kept_percent, "%"),
+                ("unwrapped_correct", q.unwrapped_correct_percent, "%"),
+                ("correct", q.correct_percent, "%"),
+                ("rmse_correct", q.rmse_correct * 100.0, "cm"),
+            ] {
+                rows.push(json!({
+                    "case": format!("{}/{}", r.scene, m.method), "metric": metric, "value": value,
+                    "unit": unit, "seed": seed, "wrapped_percent": r.wrapped_percent,
+                    "thesis_aat": r.thesis.aat, "thesis_at160": r.thesis.at160, "thesis_at240": r.thesis.at240,
+                }));
+            }
+        }
+        results.push(r);
+    }
+    eprintln!("{}", table_2_4(&results));
+    eprintln!("{}", quality_table(&results));
+
+    // The real ifm O3R frame (0.2–2 m, median 0.51 m): distances folded at 0.5 m (second frequency 0.6 m).
+    match real_data_dir().map(|d| d.join("ifm_o3r_tof_frame")) {
+        Some(dir) if dir.is_dir() => {
+            let meta = sensor_tof::io::read_meta(&dir.join("frame_meta.json"))?;
+            let frame = sensor_tof::io::read_png_pair(
+                &dir.join("radial_distance_u16.png"),
+                &dir.join("normalized_amplitude_u16.png"),
+                &meta,
+            )?;
+            let noise = sensor_tof::io::read_png_pair(
+                &dir.join("radial_distance_noise_u16.png"),
+                &dir.join("normalized_amplitude_u16.png"),
+                &meta,
+            )?;
+            let f = evaluate_folded(&frame, Some(noise.range()), 0.5, 0.6, seed)?;
+            eprintln!(
+                "ifm O3R frame folded at {} m (second frequency {} m): {} measured pixels, {:.1} % wrapped; \
+                 thresholds tuned on the even rows: {:?}; scored on the odd rows:",
+                f.fold_m, f.second_fold_m, f.measured, f.wrapped_percent, f.thresholds
+            );
+            let wrapped = sensor_tof::experiment::SceneResult {
+                scene: "ifm-folded".into(),
+                wrapped_percent: f.wrapped_percent,
+                thesis: sensor_tof::experiment::ThesisDiscarded { aat: f64::NAN, at160: f64::NAN, at240: None },
+                results: f.results.clone(),
+            };
+            eprintln!("{}", quality_table(std::slice::from_ref(&wrapped)));
+            for m in &f.results {
+                for (metric, value) in [
+                    ("discarded", m.score.discarded_percent),
+                    ("wrong_kept", m.score.wrong_kept_percent),
+                    ("unwrapped_correct", m.score.unwrapped_correct_percent),
+                    ("correct", m.score.correct_percent),
+                ] {
+                    rows.push(json!({
+                        "case": format!("ifm-folded-0.5m/{}", m.method), "metric": metric, "value": value,
+                        "unit": "%", "seed": seed,
+                    }));
+                }
+            }
+        }
+        _ => eprintln!("SKIPPED: the real ifm frame (no shared/data/real/ifm_o3r_tof_frame next to the checkout)"),
+    }
+
+    // Speed of AAT + unwrap + points against a plain copy of the frame, 176 × 144.
+    let scene = sensor_tof::scenes::tof_scene("rack-and-door")?;
+    let sim = sensor_tof::sim::TofSimulator::new(scene.sim.clone())?;
+    let frame = sim.simulate(&scene.scene, &scene.pose, seed)?.frame;
+    let aat = sensor_tof::experiment::aat_for(&sim);
+    let filter = sensor_tof::TofFilter::new(
+        frame.camera(),
+        frame.kind(),
+        &sensor_tof::FilterConfig::aat_unwrap(aat, None),
+    )?;
+    let n = frame.range().len();
+    let mut out = sensor_tof::FilterOutput::default();
+    let (mut points, mut pixels) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let reps = 2000;
+    let work = median_seconds(5, || {
+        for _ in 0..reps {
+            filter.apply(&frame, &mut out)?;
+            points.clear();
+            pixels.clear();
+            out.points_into(filter.tables(), &mut points, &mut pixels);
+            std::hint::black_box(points.len());
+        }
+        Ok(())
+    })? / reps as f64;
+    let (mut r, mut a) = (vec![0f32; n], vec![0f32; n]);
+    let copy = median_seconds(5, || {
+        for _ in 0..reps {
+            r.copy_from_slice(std::hint::black_box(frame.range()));
+            a.copy_from_slice(std::hint::black_box(frame.amplitude()));
+            std::hint::black_box(r[n - 1] + a[n - 1]);
+        }
+        Ok(())
+    })? / reps as f64;
+    eprintln!(
+        "AAT + unwrap + points, 176 x 144 simulated frame: {:.1} µs ({:.0} frames/s), plain copy {:.2} µs: ratio {:.1}",
+        work * 1e6,
+        1.0 / work,
+        copy * 1e6,
+        work / copy
+    );
+    rows.push(json!({"case": "rack-and-door/aat-unwrap-points", "metric": "time_per_frame", "value": work * 1e6,
+        "unit": "us", "frames_per_s": 1.0 / work, "copy_us": copy * 1e6, "ratio_to_copy": work / copy}));
     Ok(rows)
 }

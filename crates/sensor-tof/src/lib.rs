@@ -24,6 +24,7 @@ pub mod calibrate;
 pub mod camera;
 pub mod error;
 pub mod eval;
+pub mod experiment;
 pub mod filter;
 pub mod frame;
 pub mod io;

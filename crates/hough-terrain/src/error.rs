@@ -1,0 +1,70 @@
+//! The crate's error type.
+
+use thiserror::Error;
+
+/// Everything that can go wrong: absurd parameters, bad input clouds, writing a histogram.
+/// Messages name the parameter and the offending value.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum HoughError {
+    /// A parameter outside its domain (ranges, resolutions, thresholds, limits, mounts).
+    #[error("bad {what}: {value} (allowed: {allowed})")]
+    BadParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// Its value (radians for angles, metres for lengths).
+        value: f64,
+        /// The domain, in words.
+        allowed: &'static str,
+    },
+    /// A range whose minimum is not below its maximum, or with a non-finite end.
+    #[error("empty or non-finite {what} range [{min}, {max})")]
+    EmptyRange {
+        /// Which axis.
+        what: &'static str,
+        /// Lower end.
+        min: f64,
+        /// Upper end.
+        max: f64,
+    },
+    /// A discretisation with more bins or cells than [`crate::MAX_BINS`].
+    #[error("{what} would need {bins} bins (at most {limit})")]
+    TooManyBins {
+        /// Which structure.
+        what: &'static str,
+        /// Bins asked for.
+        bins: u64,
+        /// The limit.
+        limit: u64,
+    },
+    /// An input point with a NaN or infinite coordinate.
+    #[error("point {index} is not finite")]
+    NonFinitePoint {
+        /// Its index in the input.
+        index: usize,
+    },
+    /// An input with no points at all.
+    #[error("empty point cloud")]
+    EmptyCloud,
+    /// The floor plane (ρx = ρy = 0, d = sensor height) has no bin in the Hough space.
+    #[error("the floor has no bin: {why}")]
+    NoFloorBin {
+        /// Which part is missing.
+        why: String,
+    },
+    /// Sizes that do not belong together (counts vs. Hough space, accumulators to merge).
+    #[error("size mismatch: {why}")]
+    Mismatch {
+        /// What differs.
+        why: String,
+    },
+    /// Writing the histogram image.
+    #[error("writing PNG: {0}")]
+    Png(String),
+    /// Opening the histogram file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
+/// Shorthand for this crate's results.
+pub type Result<T, E = HoughError> = std::result::Result<T, E>;
