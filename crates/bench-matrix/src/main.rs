@@ -202,7 +202,9 @@ fn real_data_dir() -> Option<std::path::PathBuf> {
 }
 
 fn tof(seed: u64) -> Result<Vec<Value>> {
-    use sensor_tof::experiment::{Method, evaluate_folded, evaluate_scene, quality_table, table_2_4};
+    use sensor_tof::experiment::{
+        Method, evaluate_folded, evaluate_scene, quality_table, table_2_4,
+    };
     let mut rows = Vec::new();
     let mut results = Vec::new();
     for scene in sensor_tof::scenes::all_scenes()? {
@@ -252,7 +254,11 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
             let wrapped = sensor_tof::experiment::SceneResult {
                 scene: "ifm-folded".into(),
                 wrapped_percent: f.wrapped_percent,
-                thesis: sensor_tof::experiment::ThesisDiscarded { aat: f64::NAN, at160: f64::NAN, at240: None },
+                thesis: sensor_tof::experiment::ThesisDiscarded {
+                    aat: f64::NAN,
+                    at160: f64::NAN,
+                    at240: None,
+                },
                 results: f.results.clone(),
             };
             eprintln!("{}", quality_table(std::slice::from_ref(&wrapped)));
@@ -270,7 +276,9 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
                 }
             }
         }
-        _ => eprintln!("SKIPPED: the real ifm frame (no shared/data/real/ifm_o3r_tof_frame next to the checkout)"),
+        _ => eprintln!(
+            "SKIPPED: the real ifm frame (no shared/data/real/ifm_o3r_tof_frame next to the checkout)"
+        ),
     }
 
     // Speed of AAT + unwrap + points against a plain copy of the frame, 176 × 144.

@@ -33,8 +33,14 @@ pub enum Method {
     /// The AAT with unwrapping after a low plain AT of the given value (L2446–2452): darker
     /// flagged pixels are dropped instead of unwrapped.
     AatUnwrapLowAt(Real),
-    /// The AAT with unwrapping, then the spatial consistency check.
-    AatUnwrapSpatial,
+    /// The AAT with unwrapping (after an optional low AT), then the spatial consistency check
+    /// ([`crate::spatial`]) with the given isolation support (0: off).
+    AatUnwrapSpatial {
+        /// The low plain AT before unwrapping.
+        low_at: Option<Real>,
+        /// [`SpatialConfig::isolation_support`].
+        isolation_support: u32,
+    },
     /// Two-frequency unwrapping (the frame and a second one at the configured frequency).
     TwoFreq,
 }
@@ -50,7 +56,7 @@ impl Method {
             Method::AatUnwrap,
             Method::AatUnwrapLowAt(20.0),
             Method::TwoFreq,
-            Method::AatUnwrapSpatial,
+            Method::AatUnwrapSpatial { low_at: Some(20.0), isolation_support: 3 },
         ]
     }
 
@@ -61,7 +67,15 @@ impl Method {
             Method::Aat => "AAT".into(),
             Method::AatUnwrap => "AAT+unwrap".into(),
             Method::AatUnwrapLowAt(t) => format!("AAT+AT{t:.0}+unwrap"),
-            Method::AatUnwrapSpatial => "AAT+unwrap+spatial".into(),
+            Method::AatUnwrapSpatial { low_at, isolation_support } => format!(
+                "AAT+{}unwrap+spatial{}",
+                low_at.map_or(String::new(), |t| format!("AT{t:.0}+")),
+                if *isolation_support > 0 {
+                    format!("(i{isolation_support})")
+                } else {
+                    String::new()
+                }
+            ),
             Method::TwoFreq => "two-freq".into(),
         }
     }
@@ -195,7 +209,8 @@ pub fn run_method(
     let mut out = FilterOutput::default();
     // Prepare (tables, illumination) outside the timed part: `millis` is the per-frame work.
     let unwrap = match method {
-        Method::AatUnwrap | Method::AatUnwrapSpatial => Some(None),
+        Method::AatUnwrap => Some(None),
+        Method::AatUnwrapSpatial { low_at, .. } => Some(*low_at),
         Method::AatUnwrapLowAt(t) => Some(Some(*t)),
         _ => None,
     };
@@ -206,10 +221,18 @@ pub fn run_method(
         _ => None,
     };
     let filter = config.as_ref().map(|c| TofFilter::new(camera, kind, c)).transpose()?;
-    let spatial = config.as_ref().map(SpatialConfig::for_filter);
+    let spatial = match (method, &config) {
+        (Method::AatUnwrapSpatial { isolation_support, .. }, Some(c)) => Some(SpatialConfig {
+            isolation_support: *isolation_support,
+            ..SpatialConfig::for_filter(c)
+        }),
+        _ => None,
+    };
     let pair = match method {
         Method::TwoFreq => Some((
-            second.ok_or_else(|| TofError::Mismatch { why: "two-frequency unwrapping needs a second frame".into() })?,
+            second.ok_or_else(|| TofError::Mismatch {
+                why: "two-frequency unwrapping needs a second frame".into(),
+            })?,
             TwoFreqUnwrapper::new(camera, kind, two)?,
         )),
         _ => None,
@@ -217,9 +240,7 @@ pub fn run_method(
     let t0 = Instant::now();
     if let Some(f) = &filter {
         f.apply(frame, &mut out)?;
-        if *method == Method::AatUnwrapSpatial
-            && let Some(sc) = &spatial
-        {
+        if let Some(sc) = &spatial {
             reconsider(frame, &mut out, sc, f.tables())?;
         }
     }
@@ -289,18 +310,27 @@ pub struct FoldedResult {
 /// The rows of `frame` with the given parity (0 even, 1 odd), as a frame of their own (for
 /// tuning on one half and scoring on the other). The camera keeps its columns; rows are
 /// halved (geometry is not used by the scores, which compare radial ranges).
-fn rows_of(frame: &TofFrame, truth: &FrameTruth, parity: u32) -> Result<(TofFrame, FrameTruth), TofError> {
+fn rows_of(
+    frame: &TofFrame,
+    truth: &FrameTruth,
+    parity: u32,
+) -> Result<(TofFrame, FrameTruth), TofError> {
     let c = frame.camera();
     let w = c.width as usize;
     let rows: Vec<usize> = (0..c.height as usize).filter(|r| *r as u32 % 2 == parity).collect();
-    let pick = |v: &[f32]| rows.iter().flat_map(|&r| v[r * w..(r + 1) * w].iter().copied()).collect::<Vec<f32>>();
+    let pick = |v: &[f32]| {
+        rows.iter().flat_map(|&r| v[r * w..(r + 1) * w].iter().copied()).collect::<Vec<f32>>()
+    };
     let mut camera = *c;
     camera.height = rows.len() as u32;
     camera.intrinsics.fy /= 2.0;
     camera.intrinsics.cy /= 2.0;
     let sub = TofFrame::new(camera, frame.kind(), pick(frame.range()), pick(frame.amplitude()))?;
     let t = FrameTruth {
-        radial: rows.iter().flat_map(|&r| truth.radial[r * w..(r + 1) * w].iter().copied()).collect(),
+        radial: rows
+            .iter()
+            .flat_map(|&r| truth.radial[r * w..(r + 1) * w].iter().copied())
+            .collect(),
         wraps: rows.iter().flat_map(|&r| truth.wraps[r * w..(r + 1) * w].iter().copied()).collect(),
     };
     Ok((sub, t))
@@ -320,7 +350,11 @@ fn best_threshold(feature: &[Real], wrapped: &[bool]) -> Option<Real> {
     // Threshold just above order[k]: flags order[..=k].
     let (mut tp, mut fp, mut best, mut best_j) = (0usize, 0usize, None, 0.0);
     for (k, &i) in order.iter().enumerate() {
-        if wrapped[i] { tp += 1 } else { fp += 1 }
+        if wrapped[i] {
+            tp += 1
+        } else {
+            fp += 1
+        }
         let next = order.get(k + 1).map(|&j| feature[j]);
         if next == Some(feature[i]) {
             continue; // ties flag together
@@ -386,7 +420,8 @@ pub fn evaluate_folded(
     let (train, train_truth) = rows_of(&folded, &truth, 0)?;
     let (test, test_truth) = rows_of(&folded, &truth, 1)?;
     let (test2, _) = rows_of(&second, &truth, 1)?;
-    let measured_train: Vec<usize> = (0..train.range().len()).filter(|&i| train.range()[i] > 0.0).collect();
+    let measured_train: Vec<usize> =
+        (0..train.range().len()).filter(|&i| train.range()[i] > 0.0).collect();
     let wrapped: Vec<bool> = measured_train.iter().map(|&i| train_truth.wraps[i] > 0).collect();
     let feat_at: Vec<Real> = measured_train.iter().map(|&i| train.amplitude()[i] as Real).collect();
     let feat_aat: Vec<Real> = measured_train
@@ -407,7 +442,8 @@ pub fn evaluate_folded(
     };
     // The pair's phase noise from the frame's median σ at the shorter fold.
     let sigma = noise.map_or(0.0, |s| {
-        let mut v: Vec<f32> = (0..n).filter(|&i| frame.range()[i] > 0.0 && s[i] > 0.0).map(|i| s[i]).collect();
+        let mut v: Vec<f32> =
+            (0..n).filter(|&i| frame.range()[i] > 0.0 && s[i] > 0.0).map(|i| s[i]).collect();
         v.sort_by(f32::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(0.0) as Real
     });
@@ -419,7 +455,14 @@ pub fn evaluate_folded(
         max_range,
         phase_noise,
     )?;
-    let methods = [Method::At(at), Method::Aat, Method::AatUnwrap, Method::AatUnwrapSpatial, Method::TwoFreq];
+    let methods = [
+        Method::At(at),
+        Method::Aat,
+        Method::AatUnwrap,
+        Method::AatUnwrapSpatial { low_at: None, isolation_support: 0 },
+        Method::AatUnwrapSpatial { low_at: None, isolation_support: 3 },
+        Method::TwoFreq,
+    ];
     let results = methods
         .iter()
         .map(|m| run_method(m, &test, Some(&test2), &aat, &two, &test_truth))
@@ -554,8 +597,8 @@ mod tests {
         let frame = TofFrame::new(c, RangeKind::Radial, range.clone(), vec![100.0; n]).unwrap();
         let (folded, truth) = fold_frame(&frame, 1.0).unwrap();
         assert!((folded.camera().non_ambiguity_range() - 1.0).abs() < 1e-9);
-        for i in 0..n {
-            if range[i] > 0.0 {
+        for (i, &r) in range.iter().enumerate() {
+            if r > 0.0 {
                 let t = truth.radial[i].unwrap();
                 assert_eq!(truth.wraps[i] as f32, t.floor());
                 assert!((folded.range()[i] + truth.wraps[i] as f32 - t).abs() < 1e-5);
