@@ -18,6 +18,8 @@ use scene_sim::{Alrf, RangeCamera, RangeSensor, StereoCamera, scene_by_name};
 use serde_json::{Value, json};
 use std::time::Instant;
 
+mod terrain;
+
 /// A named benchmark: a function of the seed giving result rows.
 struct Bench {
     name: &'static str,
@@ -41,6 +43,12 @@ const BENCHES: &[Bench] = &[
         about: "Table 2.4: AT 160/240, AAT, AAT+unwrap, two-frequency, AAT+unwrap+spatial on six simulated \
                 scenes and a folded real frame; AAT speed",
         run: tof,
+    },
+    Bench {
+        name: "terrain",
+        about: "Tables 4.3, 4.6, 4.7: Hough terrain classes and drivability on simulated snapshots and real \
+                frames; votes per second against the literal Algorithm 2",
+        run: terrain::run,
     },
 ];
 
@@ -89,7 +97,7 @@ fn try_main() -> Result<()> {
 }
 
 /// The median wall time of `repeats` calls of `f`, in seconds.
-fn median_seconds(repeats: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
+pub(crate) fn median_seconds(repeats: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
     let mut times = Vec::with_capacity(repeats);
     for _ in 0..repeats {
         let t = Instant::now();
@@ -193,7 +201,7 @@ fn io(seed: u64) -> Result<Vec<Value>> {
 }
 
 /// The shared data folder (`$PATCHNAV_REAL_DATA`, else `shared/data/real` next to the checkout).
-fn real_data_dir() -> Option<std::path::PathBuf> {
+pub(crate) fn real_data_dir() -> Option<std::path::PathBuf> {
     let dir = match std::env::var_os("PATCHNAV_REAL_DATA") {
         Some(d) => std::path::PathBuf::from(d),
         None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real"),

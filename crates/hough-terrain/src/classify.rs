@@ -257,10 +257,16 @@ pub fn bin_type(space: &HoughSpace, bin: Bin, floor: Bin, limits: &RobotLimits) 
 /// No votes at all gives obstacle ([`Rule::NoVotes`]). The result has `accepted = true` and
 /// `valid_fraction = 1`; [`crate::HoughClassifier`] fills in the preprocessing. Fails if
 /// `floor` is not a bin of the accumulator's space.
-pub fn algorithm3(acc: &Accumulator, floor: Bin, config: &ClassifierConfig) -> Result<Classification> {
+pub fn algorithm3(
+    acc: &Accumulator,
+    floor: Bin,
+    config: &ClassifierConfig,
+) -> Result<Classification> {
     let space = acc.space();
     if floor.ix >= space.nx() || floor.iy >= space.ny() || floor.id >= space.nd() {
-        return Err(HoughError::Mismatch { why: format!("floor bin {floor:?} outside the Hough space") });
+        return Err(HoughError::Mismatch {
+            why: format!("floor bin {floor:?} outside the Hough space"),
+        });
     }
     let t = &config.thresholds;
     let pc = acc.points() as f64;

@@ -118,8 +118,8 @@ pub use accumulator::{Accumulator, NormalTable, vote_literal};
 pub use ball::{BallAccumulator, BallConfig, BallPlane, refine_plane};
 pub use classifier::{HoughClassifier, HoughConfig};
 pub use classify::{
-    Classification, ClassifierConfig, Preprocessing, RobotLimits, Rule, TerrainClass, Thresholds,
-    BinType, algorithm3, bin_type, floor_bin,
+    BinType, Classification, ClassifierConfig, Preprocessing, RobotLimits, Rule, TerrainClass,
+    Thresholds, algorithm3, bin_type, floor_bin,
 };
 pub use error::{HoughError, Result};
 pub use histogram::{HistogramStyle, hough_image, hough_png, hough_png_file};

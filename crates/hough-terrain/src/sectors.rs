@@ -30,7 +30,9 @@ impl SectorGrid {
     pub fn new(azimuth_edges: Vec<f64>, range_edges: Vec<f64>) -> Result<SectorGrid> {
         let right = std::f64::consts::FRAC_PI_2;
         let increasing = |v: &[f64]| v.len() >= 2 && v.windows(2).all(|w| w[0] < w[1]);
-        if !increasing(&azimuth_edges) || azimuth_edges.iter().any(|a| a.is_nan() || a.abs() >= right) {
+        if !increasing(&azimuth_edges)
+            || azimuth_edges.iter().any(|a| a.is_nan() || a.abs() >= right)
+        {
             return Err(HoughError::BadParameter {
                 what: "sector azimuth edges",
                 value: azimuth_edges.first().copied().unwrap_or(f64::NAN),

@@ -47,6 +47,13 @@ fn cases() -> Vec<Case> {
             drivable: [None, Some(true), Some(true)],
         },
         Case { spec: ramp(45.0), class: all(Ramp), drivable: drive(false) },
+        // Downhill ramps are hardly seen (the thesis's reason for ρx ≤ 18°): floor, drivable.
+        Case { spec: ramp(-15.0), class: all(Floor), drivable: drive(true) },
+        Case {
+            spec: TerrainSpec::Plateau { height: 0.1, distance: 1.5 },
+            class: [None; 3],
+            drivable: drive(true),
+        },
         Case {
             spec: TerrainSpec::Canyon { depth: 0.3, distance: 1.5 },
             class: all(Canyon),

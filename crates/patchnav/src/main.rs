@@ -32,6 +32,7 @@ mod scene_map;
 mod simulate;
 mod terrain;
 mod tof;
+mod tof_sim;
 
 /// Turns 3D range data into maps a robot can plan on.
 #[derive(Parser, Debug)]

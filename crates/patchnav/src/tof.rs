@@ -46,6 +46,9 @@ pub enum TofCommand {
     /// Fit the illumination parabola (Eq 2.5 with a curvature) to a frame of a perpendicular
     /// white wall and write it as JSON (a sidecar's `aat.calibration` can name it).
     Calibrate(CalibrateArgs),
+    /// Simulate a frame of one of the six test scenes of thesis Table 2.4 (SR-3100, wrap-around,
+    /// noise, sunlight, scattering, dark materials) as a PNG pair + sidecar, with the truth.
+    Simulate(crate::tof_sim::SimulateArgs),
 }
 
 /// The frame to read: a PNG pair, or an organised cloud, with its sidecar.
@@ -180,6 +183,7 @@ pub fn run(command: &TofCommand, progress: &Progress) -> Result<()> {
     match command {
         TofCommand::Filter(args) => filter(args, progress),
         TofCommand::Calibrate(args) => calibrate(args, progress),
+        TofCommand::Simulate(args) => crate::tof_sim::run(args, progress),
     }
 }
 
