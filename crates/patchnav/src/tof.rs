@@ -112,10 +112,11 @@ pub struct FilterArgs {
     /// Use the radial distance as Eq 2.4's r_p (default: the depth, as the thesis).
     #[arg(long)]
     pub radial: bool,
-    /// Clamp the illumination model to ≥ 1 amplitude unit, so the image corners where Eq 2.5
-    /// goes negative are tested too (default: they always pass, as Eq 2.4 literally says).
-    #[arg(long)]
-    pub clamp_corners: bool,
+    /// Clamp the illumination model to at least this fraction of its maximum (0.04 if given
+    /// without a value), so the image corners where Eq 2.5 goes negative are tested too
+    /// (default: they always pass, as Eq 2.4 literally says).
+    #[arg(long, num_args = 0..=1, default_missing_value = "0.04", value_name = "FRACTION")]
+    pub clamp_corners: Option<Real>,
     /// Two-frequency: the second frame's range PNG.
     #[arg(long, requires_all = ["amplitude2", "meta2"])]
     pub range2: Option<PathBuf>,
@@ -246,8 +247,14 @@ fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
             if args.radial {
                 aat.range = AatRange::Radial;
             }
-            if args.clamp_corners {
-                aat.negative = NegativeIllumination::Clamp(1.0);
+            if let Some(fraction) = args.clamp_corners {
+                if !(fraction.is_finite() && fraction > 0.0 && fraction <= 1.0) {
+                    bail!("--clamp-corners {fraction}: want a fraction in (0, 1]");
+                }
+                let aw = sensor_tof::filter::illumination_table(&aat.illumination, frame.camera())?;
+                let max = aw.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+                aat.negative =
+                    NegativeIllumination::Clamp((fraction * max).max(Real::MIN_POSITIVE));
             }
             let name = format!("AAT {}", aat.threshold);
             let config = if args.unwrap {

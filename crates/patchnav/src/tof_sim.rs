@@ -37,10 +37,12 @@ const METRES_PER_UNIT: Real = 0.0005;
 
 /// Runs `patchnav tof simulate`.
 pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
-    let scene = tof_scene(&args.scene)
-        .with_context(|| format!("unknown scene `{}` (known: {})", args.scene, SCENE_NAMES.join(", ")))?;
+    let scene = tof_scene(&args.scene).with_context(|| {
+        format!("unknown scene `{}` (known: {})", args.scene, SCENE_NAMES.join(", "))
+    })?;
     let sim = TofSimulator::new(scene.sim.clone())?;
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let (a, b) = match args.second_frequency {
         Some(hz) => {
             let (a, b) = sim.simulate_two_frequencies(&scene.scene, &scene.pose, hz, args.seed)?;
@@ -91,7 +93,8 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
     let c = a.frame.camera();
     for (name, data) in [("truth_radial.png", &truth_units), ("truth_wraps.png", &wraps)] {
         let path = args.out.join(name);
-        write_u16_png(&path, c.width, c.height, data).with_context(|| format!("writing {}", path.display()))?;
+        write_u16_png(&path, c.width, c.height, data)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     let wrapped = a.truth.wraps.iter().filter(|&&w| w > 0).count();
     progress.report(&format!(

@@ -28,6 +28,14 @@ pub enum Method {
     At(Real),
     /// The AAT with the thesis's parameters (AAT 0.2, the camera's illumination), dropping.
     Aat,
+    /// The AAT with `aw_p` clamped to at least the given value (spec §6.2: the corners where the
+    /// parabola is negative are tested too) and/or the radial range in Eq 2.4 (spec §6.1).
+    AatVariant {
+        /// [`crate::NegativeIllumination::Clamp`] value, if any.
+        clamp: Option<Real>,
+        /// Use the radial distance instead of the depth.
+        radial: bool,
+    },
     /// The AAT with unwrapping (no low AT).
     AatUnwrap,
     /// The AAT with unwrapping after a low plain AT of the given value (L2446–2452): darker
@@ -53,6 +61,8 @@ impl Method {
             Method::At(160.0),
             Method::At(240.0),
             Method::Aat,
+            Method::AatVariant { clamp: Some(480.0), radial: false },
+            Method::AatVariant { clamp: None, radial: true },
             Method::AatUnwrap,
             Method::AatUnwrapLowAt(20.0),
             Method::TwoFreq,
@@ -65,6 +75,14 @@ impl Method {
         match self {
             Method::At(t) => format!("AT {t:.0}"),
             Method::Aat => "AAT".into(),
+            Method::AatVariant { clamp, radial } => format!(
+                "AAT({})",
+                [clamp.map(|c| format!("aw>={c}")), radial.then(|| "radial".to_string())]
+                    .into_iter()
+                    .flatten()
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
             Method::AatUnwrap => "AAT+unwrap".into(),
             Method::AatUnwrapLowAt(t) => format!("AAT+AT{t:.0}+unwrap"),
             Method::AatUnwrapSpatial { low_at, isolation_support } => format!(
@@ -217,6 +235,16 @@ pub fn run_method(
     let config = match (method, unwrap) {
         (Method::At(t), _) => Some(FilterConfig::at(*t)),
         (Method::Aat, _) => Some(FilterConfig::aat(aat.clone())),
+        (Method::AatVariant { clamp, radial }, _) => {
+            let mut a = aat.clone();
+            if let Some(c) = clamp {
+                a.negative = crate::NegativeIllumination::Clamp(*c);
+            }
+            if *radial {
+                a.range = crate::AatRange::Radial;
+            }
+            Some(FilterConfig::aat(a))
+        }
         (_, Some(low)) => Some(FilterConfig::aat_unwrap(aat.clone(), low)),
         _ => None,
     };
@@ -560,7 +588,7 @@ pub fn quality_table(results: &[SceneResult]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<14} {:<20} {:>8} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}",
+        "{:<14} {:<28} {:>8} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}",
         "scene", "method", "disc.%", "wrong%", "wrapkept%", "unwrap%", "correct%", "rmse cm", "ms"
     );
     for r in results {
@@ -568,7 +596,7 @@ pub fn quality_table(results: &[SceneResult]) -> String {
             let q = &m.score;
             let _ = writeln!(
                 s,
-                "{:<14} {:<20} {:>8.1} {:>8.2} {:>10.2} {:>9.1} {:>9.1} {:>9.2} {:>8.3}",
+                "{:<14} {:<28} {:>8.1} {:>8.2} {:>10.2} {:>9.1} {:>9.1} {:>9.2} {:>8.3}",
                 r.scene,
                 m.method,
                 q.discarded_percent,

@@ -14,6 +14,7 @@
 //! | simulator on `scene-sim`'s range camera | [`sim`] | §2.5.4 error types, Table 2.3 |
 //! | the six test scenes of Table 2.4 | [`scenes`] | §2.5.6 |
 //! | scoring against the truth | [`eval`] | Table 2.4 (+ our metrics) |
+//! | the Table 2.4 experiment, folded real frames | [`experiment`] | §2.5.6 |
 //! | 16-bit PNG range/amplitude pairs with a JSON sidecar | [`io`] | — |
 //!
 //! Where the thesis is ambiguous this crate follows the spec's resolutions: `r_p` of Eq 2.4 is
@@ -33,6 +34,7 @@ pub mod sim;
 pub mod spatial;
 pub mod two_freq;
 
+pub use calibrate::Calibration;
 pub use camera::{
     Demodulated, SPEED_OF_LIGHT, TofCamera, demodulate, modulate, non_ambiguity_range,
 };
@@ -43,3 +45,7 @@ pub use filter::{
     OutcomeCounts, Parabola, PixelOutcome, RayTables, TofFilter, UnwrapConfig, WhiteWallTable,
 };
 pub use frame::TofFrame;
+pub use io::FrameMeta;
+pub use sim::{SimConfig, SimulatedFrame, TofSimulator};
+pub use spatial::SpatialConfig;
+pub use two_freq::{TwoFreqConfig, TwoFreqUnwrapper};

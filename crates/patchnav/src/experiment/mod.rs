@@ -15,6 +15,7 @@ use clap::Subcommand;
 mod extraction;
 mod lab;
 mod office;
+mod tof;
 
 /// The experiments.
 #[derive(Subcommand, Debug)]
@@ -31,6 +32,10 @@ pub enum ExperimentCommand {
     /// Thesis §5.3: segmentation quality (SegComp), the outlining survey (Figs 5.12–5.14),
     /// outline fidelity and patch sizes (Table 5.1) on simulated and real scans.
     Extraction(extraction::ExtractionArgs),
+    /// Thesis Table 2.4: the adaptive amplitude threshold against amplitude thresholds, with
+    /// unwrapping, two-frequency unwrapping and the spatial check, on six simulated scenes
+    /// (and a real frame folded at a chosen non-ambiguity range with `--real`).
+    Tof(tof::TofArgs),
 }
 
 /// Runs `patchnav experiment ...`.
@@ -40,5 +45,6 @@ pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
         ExperimentCommand::LabTiming(args) => lab::run_timing(args, progress),
         ExperimentCommand::LabVolume(args) => lab::run_volume(args, progress),
         ExperimentCommand::Extraction(args) => extraction::run(args, progress),
+        ExperimentCommand::Tof(args) => tof::run(args, progress),
     }
 }
