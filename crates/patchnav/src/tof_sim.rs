@@ -16,7 +16,8 @@ use std::path::PathBuf;
 /// Arguments of `patchnav tof simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// The scene: rack-and-door, corner-window, gates, close-boxes, dark-material or sun.
+    /// The scene: rack-and-door, corner-window, gates, close-boxes, dark-material, sun (the six
+    /// of Table 2.4), or white-wall (a white wall at 1 m, for `tof calibrate`).
     pub scene: String,
     /// Output folder: `range.png`, `amplitude.png`, `meta.json` (with the AAT parameters of the
     /// simulated camera), `truth_radial.png` (true radial distance, same scale; 0 = nothing

@@ -97,11 +97,36 @@ pub fn tof_scene(name: &str) -> Result<TofScene, TofError> {
         "close-boxes" => close_boxes(),
         "dark-material" => dark_material(),
         "sun" => sun(),
+        "white-wall" => white_wall(1.0),
         _ => Err(TofError::BadParameter {
             what: "scene name",
-            why: format!("{name:?} (known: {})", SCENE_NAMES.join(", ")),
+            why: format!("{name:?} (known: {}, white-wall)", SCENE_NAMES.join(", ")),
         }),
     }
+}
+
+/// The calibration scene of L2338–2340: a plain white wall (ρ = 1) perpendicular to the optical
+/// axis at `distance` metres, filling the view, no scattering, no sun (`tof_scene("white-wall")`
+/// is the thesis's 1 m). Fails for a distance outside (0.3, 10] m.
+pub fn white_wall(distance: Real) -> Result<TofScene, TofError> {
+    if !(distance > 0.3 && distance <= 10.0) {
+        return Err(TofError::BadParameter {
+            what: "white-wall distance",
+            why: format!("{distance} m (want (0.3, 10] m)"),
+        });
+    }
+    let mut b = SceneBuilder::new("white-wall");
+    let white = Material::new(1.0, false)?;
+    slab(&mut b, "wall", [-20.0, distance, -20.0], [20.0, distance + 0.1, 20.0], white)?;
+    Ok(TofScene {
+        name: "white-wall",
+        description: "A white wall perpendicular to the optical axis, filling the view: the \
+                      frame the illumination model is calibrated on (Eq 2.5, L2338–2340).",
+        scene: b.build()?,
+        pose: camera(0.0, 0.0, 90.0, 0.0),
+        sim: SimConfig { roughness: 0.0, ..SimConfig::sr3100() },
+        thesis: ThesisRow { aat: Real::NAN, at160: Real::NAN, at240: None },
+    })
 }
 
 /// All six scenes in Table 2.4's order.

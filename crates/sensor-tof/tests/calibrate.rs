@@ -288,3 +288,21 @@ proptest! {
         prop_assert!((p.curvature / t.curvature - 1.0).abs() < 1e-3, "{:?} vs {:?}", p, t);
     }
 }
+
+/// The simulator and the calibration agree: a simulated white wall at 1 m (noise, saturation,
+/// the 4 % light floor in the corners) gives back the SR-3100 parabola the simulator was built
+/// with (Eq 2.5: Â = 12,000, δ = (88, 72), k = 1).
+#[test]
+fn calibration_recovers_the_simulated_camera() {
+    let scene = sensor_tof::scenes::white_wall(1.0).unwrap();
+    let sim = sensor_tof::sim::TofSimulator::new(scene.sim.clone()).unwrap();
+    let frame = sim.simulate(&scene.scene, &scene.pose, 5).unwrap().frame;
+    // The floored corners are not on the parabola: trim them away.
+    let options = CalibrationOptions { trim_sigma: Some(3.0), ..CalibrationOptions::default() };
+    let c = fit_parabola(&frame, &options).unwrap();
+    let p = c.parabola;
+    assert!((p.a_hat / 12_000.0 - 1.0).abs() < 0.02, "{p:?}");
+    assert!((p.delta_x - 88.0).abs() < 1.0 && (p.delta_y - 72.0).abs() < 1.0, "{p:?}");
+    assert!((p.curvature - 1.0).abs() < 0.05, "{p:?}");
+    assert!(sensor_tof::scenes::white_wall(0.0).is_err());
+}
