@@ -222,6 +222,7 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
             for (metric, value, unit) in [
                 ("discarded", q.discarded_percent, "%"),
                 ("wrong_kept", q.wrong_kept_percent, "%"),
+                ("gross", q.gross_percent, "%"),
                 ("wrapped_kept", q.wrapped_kept_percent, "%"),
                 ("unwrapped_correct", q.unwrapped_correct_percent, "%"),
                 ("correct", q.correct_percent, "%"),

@@ -34,6 +34,9 @@ pub struct Score {
     pub wrapped: usize,
     /// Of those, % output within the tolerance of the truth (correctly unwrapped).
     pub unwrapped_correct_percent: Real,
+    /// Output pixels with no true surface or more than 1 m off (a wrong wrap decision, a pixel
+    /// that saw nothing), % of output pixels.
+    pub gross_percent: Real,
     /// Root mean square radial error of all output pixels with a true surface, metres.
     pub rmse_output: Real,
     /// Root mean square radial error of the correct output pixels (the noise level), metres.
@@ -71,6 +74,7 @@ pub fn score(
     let mut s = Score { pixels: n, ..Score::default() };
     let (mut dropped, mut wrong, mut wrapped_kept, mut unwrapped_ok, mut correct, mut known) =
         (0, 0, 0, 0, 0, 0);
+    let mut gross = 0usize;
     let (mut se_all, mut n_all, mut se_ok) = (0.0, 0usize, 0.0);
     #[allow(clippy::needless_range_loop)] // five parallel arrays
     for i in 0..n {
@@ -89,9 +93,11 @@ pub fn score(
         s.output += 1;
         let Some(t) = t else {
             wrong += 1;
+            gross += 1;
             continue;
         };
         let e = (out.radial[i] - t) as Real;
+        gross += (e.abs() > 1.0) as usize;
         se_all += e * e;
         n_all += 1;
         if e.abs() <= tolerance {
@@ -111,6 +117,7 @@ pub fn score(
     s.discarded_percent = pct(dropped, n);
     s.wrong_kept_percent = pct(wrong, s.output);
     s.wrapped_kept_percent = pct(wrapped_kept, s.output);
+    s.gross_percent = pct(gross, s.output);
     s.unwrapped_correct_percent = pct(unwrapped_ok, s.wrapped);
     s.correct_percent = pct(correct, known);
     s.rmse_output = if n_all == 0 { 0.0 } else { (se_all / n_all as Real).sqrt() };
@@ -139,6 +146,7 @@ mod tests {
         assert_eq!(s.output, 4);
         assert_eq!(s.wrong_kept_percent, 50.0); // pixel 1 (wrapped, kept) and 4 (no surface)
         assert_eq!(s.wrapped_kept_percent, 25.0);
+        assert_eq!(s.gross_percent, 50.0); // pixel 1 (7.5 m off) and 4 (no surface)
         assert_eq!(s.wrapped, 3);
         assert!((s.unwrapped_correct_percent - 100.0 / 3.0).abs() < 1e-9);
         assert!((s.rmse_correct - ((0.01f64.powi(2) + 0.02f64.powi(2)) / 2.0).sqrt()).abs() < 1e-6);

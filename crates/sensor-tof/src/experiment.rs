@@ -581,26 +581,37 @@ pub fn table_2_4(results: &[SceneResult]) -> String {
 }
 
 /// What the thesis could not measure: per scene and method the % wrong pixels among those
-/// output, the % wrapped pixels correctly unwrapped, the % of measurable pixels output
+/// output (and of those the gross errors, more than 1 m off), the % wrapped pixels correctly
+/// unwrapped, the % of measurable pixels output
 /// correctly, and the RMSE of the correct output (cm).
 pub fn quality_table(results: &[SceneResult]) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<14} {:<28} {:>8} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}",
-        "scene", "method", "disc.%", "wrong%", "wrapkept%", "unwrap%", "correct%", "rmse cm", "ms"
+        "{:<14} {:<28} {:>8} {:>8} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}",
+        "scene",
+        "method",
+        "disc.%",
+        "wrong%",
+        "gross%",
+        "wrapkept%",
+        "unwrap%",
+        "correct%",
+        "rmse cm",
+        "ms"
     );
     for r in results {
         for m in &r.results {
             let q = &m.score;
             let _ = writeln!(
                 s,
-                "{:<14} {:<28} {:>8.1} {:>8.2} {:>10.2} {:>9.1} {:>9.1} {:>9.2} {:>8.3}",
+                "{:<14} {:<28} {:>8.1} {:>8.2} {:>8.2} {:>10.2} {:>9.1} {:>9.1} {:>9.2} {:>8.3}",
                 r.scene,
                 m.method,
                 q.discarded_percent,
                 q.wrong_kept_percent,
+                q.gross_percent,
                 q.wrapped_kept_percent,
                 q.unwrapped_correct_percent,
                 q.correct_percent,
