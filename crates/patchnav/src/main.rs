@@ -20,6 +20,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod convert;
+mod demo;
 mod experiment;
 mod extract;
 mod info;
@@ -63,6 +64,9 @@ enum Command {
         #[command(flatten)]
         options: input::InputArgs,
     },
+    /// The main job on the built-in example: simulate the lab, filter a ToF frame, classify
+    /// terrain, extract patches, build every map, plan on each, and write an HTML report.
+    Demo(demo::DemoArgs),
     /// Scan a synthetic scene with a simulated sensor from several poses.
     Simulate(simulate::SimulateArgs),
     /// Planar (and trimesh) patches from range scans, merged across scans, as a map file.
@@ -90,6 +94,7 @@ fn main() -> ExitCode {
         Command::Convert { input, output, options } => {
             convert::run(&input, &output, &options, &progress)
         }
+        Command::Demo(args) => demo::run(&args, &progress),
         Command::Simulate(args) => simulate::run(&args, &progress),
         Command::Extract(args) => extract::run(&args, &progress),
         Command::Map(command) => map::run(&command, &progress),
