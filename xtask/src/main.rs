@@ -9,6 +9,9 @@
 //!   our plane extraction beside PCL's and Open3D's on the shared floor-plan clouds, one process
 //!   per run, quality against the floor plan's mesh; JSONL rows to `target/peers/planes.jsonl`
 //!   and a side-by-side table on stdout (docs/extraction-peers.md).
+//! * `cargo xtask peers terrain [--peers-dir DIR] [--peers-build DIR] [--out F]`: our Hough
+//!   terrain classification beside one RANSAC ground-plane fit of PCL and Open3D on the same
+//!   frames, ratio ours/theirs (docs/terrain.md).
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -28,6 +31,8 @@ commands:
   bench --list                          list the benchmark names
   peers planes [--peers-dir D] [--peers-build D] [--bench-dir D] [--out F]
                                         our plane extraction beside PCL and Open3D (same inputs)
+  peers terrain [--peers-dir D] [--peers-build D] [--out F]
+                                        Hough terrain classes beside a RANSAC ground plane (PCL, Open3D)
 ";
 
 fn main() -> ExitCode {

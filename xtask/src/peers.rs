@@ -1,5 +1,7 @@
 //! `cargo xtask peers planes`: our plane extraction beside PCL's and Open3D's, on the same
 //! inputs, one process per run, with one side-by-side table (docs/extraction-peers.md).
+//! `cargo xtask peers terrain` (module `terrain`, docs/terrain.md): our Hough terrain
+//! classification beside one RANSAC ground-plane fit on the same frames.
 //!
 //! Inputs: the shared bench's `floorplan_scan.ply` (organised 640 × 480 depth image in the
 //! camera's optical frame) and `floorplan.ply` (unorganised surface samples in the world frame).
@@ -20,6 +22,9 @@
 
 use anyhow::{Context, Result, bail};
 use pointcloud::{Point3, Vector3};
+
+#[path = "peers_terrain.rs"]
+mod terrain;
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -57,8 +62,8 @@ fn parse(args: &[String]) -> Result<Args> {
     let mut it = args.iter();
     match it.next().map(String::as_str) {
         Some("planes") => {}
-        Some(other) => bail!("unknown peers comparison `{other}` (only `planes`)"),
-        None => bail!("peers needs a comparison: `planes`"),
+        Some(other) => bail!("unknown peers comparison `{other}` (`planes` or `terrain`)"),
+        None => bail!("peers needs a comparison: `planes` or `terrain`"),
     }
     while let Some(a) = it.next() {
         let mut value = || it.next().with_context(|| format!("{a} needs a value"));
@@ -86,6 +91,9 @@ struct Run {
 
 /// Runs `cargo xtask peers ARGS`.
 pub fn run(args: &[String]) -> Result<()> {
+    if args.first().map(String::as_str) == Some("terrain") {
+        return terrain::run(&args[1..]);
+    }
     let args = parse(args)?;
     let root = crate::project_root();
     let peers = args.peers_dir.clone();

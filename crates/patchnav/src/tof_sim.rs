@@ -98,7 +98,7 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let wrapped = a.truth.wraps.iter().filter(|&&w| w > 0).count();
-    progress.report(&format!(
+    progress.report(format!(
         "{}: {} × {} frame at {:.1} MHz ({:.2} m non-ambiguity range), {} measured pixels, {:.1} % wrapped; written to {}",
         scene.name,
         c.width,

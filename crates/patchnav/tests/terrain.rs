@@ -1,0 +1,116 @@
+//! `patchnav terrain` as a user meets it: simulated range-camera frames written to files,
+//! classified by the binary.
+
+use pointcloud::{Point3, SensorPose};
+use scene_sim::{RangeCamera, RangeSensor, TerrainSpec, terrain};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn patchnav(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// An SR-3000 frame of `spec` from a level camera 0.45 m above the floor, written as PLY.
+fn frame(dir: &Path, name: &str, spec: TerrainSpec) -> PathBuf {
+    let scene = terrain(&spec, 1).unwrap();
+    let cam = RangeCamera::swissranger_sr3000();
+    let body = SensorPose::from_position_rpy(Point3::new(0.0, 0.0, 0.45), 0.0, 0.0, 0.0);
+    let cloud = cam.scan(&scene, &cam.mount(&body), 7).to_cloud().unwrap();
+    let path = dir.join(name);
+    pointcloud::io::write_cloud(&path, &cloud).unwrap();
+    path
+}
+
+fn line<'a>(text: &'a str, key: &str) -> &'a str {
+    text.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("no `{key}` in {text}"))
+}
+
+#[test]
+fn floor_is_floor_and_drivable_wall_is_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = frame(dir.path(), "floor.ply", TerrainSpec::Floor);
+    let o = patchnav(&["terrain", floor.to_str().unwrap(), "--sensor-height", "0.45"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert_eq!(line(&text, "class:"), "class:     floor", "{text}");
+    assert_eq!(line(&text, "drivable:"), "drivable:  yes", "{text}");
+    assert!(line(&text, "plane:").contains("ρx 0.0°, ρy 0.0°, d 0.45 m"), "{text}");
+    assert!(line(&text, "time:").contains("ms"), "{text}");
+
+    let wall = frame(dir.path(), "wall.ply", TerrainSpec::Wall { distance: 1.0, height: 2.0 });
+    for res in ["45", "15", "9"] {
+        let o = patchnav(&["terrain", wall.to_str().unwrap(), "--resolution", res]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = stdout(&o);
+        assert_eq!(line(&text, "drivable:"), "drivable:  no", "at {res}°: {text}");
+        assert_eq!(line(&text, "class:"), "class:     obstacle", "at {res}°: {text}");
+    }
+}
+
+#[test]
+fn sectors_and_json_report_the_same_class() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = frame(dir.path(), "floor.ply", TerrainSpec::Floor);
+    let o = patchnav(&[
+        "terrain",
+        floor.to_str().unwrap(),
+        "--sectors",
+        "3",
+        "--json",
+        "--repeat",
+        "3",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["class"], "floor");
+    assert_eq!(v["drivable"], true);
+    assert_eq!(v["sectors"].as_array().unwrap().len(), 3);
+    assert!(v["time_ms"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn hough_png_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = frame(dir.path(), "floor.ply", TerrainSpec::Floor);
+    let png = dir.path().join("hough.png");
+    let o = patchnav(&["terrain", floor.to_str().unwrap(), "--hough-png", png.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+}
+
+/// Asserts a failure reported as one `error:` line and exit code 1.
+fn assert_one_line_error(o: &Output, needle: &str) {
+    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
+    let err = stderr(o);
+    assert_eq!(err.lines().count(), 1, "one line expected, got: {err}");
+    assert!(err.starts_with("error: "), "{err}");
+    assert!(err.contains(needle), "`{needle}` not in: {err}");
+}
+
+#[test]
+fn bad_input_is_one_line_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing.ply");
+    assert_one_line_error(&patchnav(&["terrain", missing.to_str().unwrap()]), "missing.ply");
+    let garbage = dir.path().join("garbage.ply");
+    std::fs::write(&garbage, b"not a ply file\n").unwrap();
+    assert_one_line_error(&patchnav(&["terrain", garbage.to_str().unwrap()]), "garbage.ply");
+    let floor = frame(dir.path(), "floor.ply", TerrainSpec::Floor);
+    let f = floor.to_str().unwrap();
+    assert_one_line_error(&patchnav(&["terrain", f, "--resolution", "0"]), "--resolution");
+    assert_one_line_error(&patchnav(&["terrain", f, "--resolution", "NaN"]), "--resolution");
+    assert_one_line_error(&patchnav(&["terrain", f, "--max-range=-1"]), "--max-range");
+    // Everything behind a lidar-convention sensor: nothing ahead.
+    let behind = dir.path().join("behind.xyz");
+    std::fs::write(&behind, "-1 0 -0.4\n-2 0.5 -0.4\n-3 -0.5 -0.4\n").unwrap();
+    assert_one_line_error(&patchnav(&["terrain", behind.to_str().unwrap()]), "no point ahead");
+}
