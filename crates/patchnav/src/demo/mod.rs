@@ -44,7 +44,8 @@ impl DemoArgs {
 
 /// Runs `patchnav demo`.
 pub fn run(args: &DemoArgs, progress: &Progress) -> Result<()> {
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let results = pipeline::run(args.scale(), args.seed, &args.out, progress)?;
     let json = args.out.join("results.json");
     std::fs::write(&json, serde_json::to_string(&results)? + "\n")
