@@ -303,7 +303,7 @@ pub(crate) fn evasion_planner(
 }
 
 /// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).
-fn write_obj_lines(
+pub(crate) fn write_obj_lines(
     path: &Path,
     points: &[Point3],
     lines: impl Iterator<Item = Vec<usize>>,

@@ -563,7 +563,7 @@ fn sphere_mesh(centre: &Point3, r: Real, t: &Tessellation) -> Result<TrimeshPatc
 }
 
 /// The constrained Delaunay triangulation of a planar patch, in the world.
-fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+pub(crate) fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     let rings: Vec<Vec<[f64; 2]>> =
         p.polygon().rings().map(|r| r.points().iter().map(|q| [q.x, q.y]).collect()).collect();
     let t = triangulate_polygon(&rings)?;

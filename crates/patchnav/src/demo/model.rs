@@ -225,6 +225,9 @@ pub struct VolumeSection {
     pub cell: f64,
     /// Map types, in table order.
     pub maps: Vec<String>,
+    /// Explored volume per map type, m³ (Table 6.2's first column).
+    #[serde(default)]
+    pub volumes_m3: Vec<f64>,
     /// `table[i][j]`: % of map i's explored volume that map j's does not cover (Table 6.2
     /// layout; `None` on the diagonal).
     pub table: Vec<Vec<Option<f64>>>,

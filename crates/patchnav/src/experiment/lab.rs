@@ -193,7 +193,7 @@ struct Lab {
 }
 
 /// The box common to all maps.
-fn common_box(maps: &[BuiltMap]) -> Aabb {
+pub(crate) fn common_box(maps: &[BuiltMap]) -> Aabb {
     let boxes: Vec<Aabb> = maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
     let min = boxes.iter().fold(boxes[0].min, |a, b| a.sup(&b.min));
     let max = boxes.iter().fold(boxes[0].max, |a, b| a.inf(&b.max));
@@ -247,7 +247,7 @@ fn build_lab(args: &LabMapArgs, progress: &Progress) -> Result<Lab> {
 
 /// The first point free on every map (and inside every map's box) on a spiral of candidates
 /// from 0.6 m inside each room corner at 1.0 m height; `args.starts` of them.
-fn corner_starts(maps: &[BuiltMap], common: &Aabb, args: &LabMapArgs) -> Result<Vec<Point3>> {
+pub(crate) fn corner_starts(maps: &[BuiltMap], common: &Aabb, args: &LabMapArgs) -> Result<Vec<Point3>> {
     let [lx, ly, _] = scene_sim::lab_layout::ROOM;
     let corners =
         [(0.0, 0.0, 1.0, 1.0), (lx, 0.0, -1.0, 1.0), (lx, ly, -1.0, -1.0), (0.0, ly, 1.0, -1.0)];
@@ -347,15 +347,15 @@ fn table_6_1(lab: &Lab, args: &LabMapArgs) -> Result<String> {
 
 /// A [`Termination`] that records the time since `solve` began whenever the iteration count
 /// reaches the next checkpoint, and stops at the last one.
-struct CheckpointTimer {
+pub(crate) struct CheckpointTimer {
     checkpoints: Vec<u64>,
-    seconds: Vec<f64>,
+    pub(crate) seconds: Vec<f64>,
     /// Roadmap vertices at each checkpoint (for the time per vertex).
-    vertices: Vec<usize>,
+    pub(crate) vertices: Vec<usize>,
 }
 
 impl CheckpointTimer {
-    fn new(checkpoints: Vec<u64>) -> CheckpointTimer {
+    pub(crate) fn new(checkpoints: Vec<u64>) -> CheckpointTimer {
         CheckpointTimer {
             seconds: Vec::with_capacity(checkpoints.len()),
             vertices: Vec::with_capacity(checkpoints.len()),
@@ -379,7 +379,7 @@ impl Termination for CheckpointTimer {
 
 /// The checkpoints of a run to `k`: every `k / n` iterations (rounded up), plus 100, 500 and
 /// 1000 when they are below `k`.
-fn checkpoints(k: u64, n: u64) -> Vec<u64> {
+pub(crate) fn checkpoints(k: u64, n: u64) -> Vec<u64> {
     let step = k.div_ceil(n.max(1)).max(1);
     let mut c: Vec<u64> = (1..).map(|i| i * step).take_while(|&x| x < k).collect();
     c.extend([100, 500, 1000].into_iter().filter(|&x| x < k));
@@ -672,7 +672,7 @@ fn timing_svg(runs: &[TimedRun], cps: &[u64], kinds: &[MapKind], a: &LabMapArgs)
 /// The part of `roadmap` that is explored space: every edge, and every vertex whose sphere is
 /// free. The PRM adds samples without a validity check (thesis Algorithm 14, spec §4), so a
 /// sample inside an obstacle stays an isolated vertex; its sphere is not explored volume.
-fn explored(roadmap: &Roadmap, map: &AnyMap, radius: Real) -> Result<Roadmap> {
+pub(crate) fn explored(roadmap: &Roadmap, map: &AnyMap, radius: Real) -> Result<Roadmap> {
     let mut free = Vec::with_capacity(roadmap.node_count());
     for v in roadmap.node_indices() {
         let keep = roadmap.neighbors(v).next().is_some()

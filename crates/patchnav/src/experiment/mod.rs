@@ -13,7 +13,7 @@ use anyhow::Result;
 use clap::Subcommand;
 
 mod extraction;
-mod lab;
+pub(crate) mod lab;
 mod office;
 mod tof;
 

@@ -1,0 +1,311 @@
+//! Planning on the four map types: RRT and PRM from a room corner to the other three
+//! (path metrics, thesis §5.6), RRTs timed against iterations (Fig 6.4, thesis Algorithm 13
+//! as run for §6.1) and their explored volumes compared (Table 6.2, Fig 6.1).
+
+use super::maps::Built;
+use super::{
+    Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, SCAN_HEIGHT, STEP, Settings, decimate, p3, p3mm,
+};
+use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
+use crate::experiment::lab::{
+    CheckpointTimer, LabMapArgs, checkpoints, common_box, corner_starts, explored,
+};
+use crate::plan::write_obj_lines;
+use crate::progress::Progress;
+use crate::scene_map::{BuiltMap, MapKind, MapSource, PatchBackend};
+use anyhow::{Context, Result, bail};
+use patch_core::Point3;
+use patch_map::AnyMap;
+use roadmap::metrics::{quantile, turn_angles, upper_quartile};
+use roadmap::volume::{CongruenceTable, VoxelGrid};
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, PlanningSpace,
+    Prm, PrmConfig, Problem, Rrt, RrtConfig,
+};
+use std::time::Instant;
+
+/// The planners run on every map type.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+enum Choice {
+    /// Goal-biased RRT.
+    Rrt,
+    /// PRM.
+    Prm,
+}
+
+/// RRT first, then PRM.
+const PLANNERS: [Choice; 2] = [Choice::Rrt, Choice::Prm];
+
+/// Probability that an RRT sample is an unreached goal's centre (LaValle's goal bias; the
+/// thesis's Lab runs grow without goals, its office runs test the goal directly instead).
+pub const RRT_GOAL_BIAS: f64 = 0.05;
+
+/// The planner `choice` on `map`: thesis Algorithm 13 with a goal bias of [`RRT_GOAL_BIAS`],
+/// or Algorithm 14 as the thesis configures it (six neighbours, no edge-length limit). Neither
+/// tests the direct step to a goal after each vertex (the §6.2.3 Lesum variant): in the lab
+/// the corners see each other at 1 m height, so that test alone would solve every problem
+/// without a roadmap.
+fn planner(choice: Choice, map: &AnyMap, space: PlanningSpace, seed: u64) -> Box<dyn Planner + '_> {
+    match choice {
+        Choice::Rrt => {
+            let config = RrtConfig { goal_bias: RRT_GOAL_BIAS, ..RrtConfig::thesis() };
+            Box::new(Rrt::new(map, space, config, seed))
+        }
+        Choice::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
+    }
+}
+
+/// The lab experiments' settings for what the corner search reads (radius, four corners).
+fn corner_args() -> LabMapArgs {
+    LabMapArgs {
+        scene_seed: 0,
+        scans: 0,
+        scan_step_deg: None,
+        scan_height: SCAN_HEIGHT,
+        curved_edge: 0.1,
+        mesh_edge: 0.1,
+        max_patch_triangles: 324,
+        source: MapSource::Scans,
+        backend: PatchBackend::Trimesh,
+        maps: MapKind::ALL.to_vec(),
+        radius: RADIUS,
+        step: STEP,
+        starts: 4,
+        max_iterations: 0,
+        common_box: false,
+    }
+}
+
+/// The first point free on every map near each of the four room corners, 1 m up (the lab
+/// experiments' starts).
+pub(super) fn starts(built: &Built) -> Result<Vec<Point3>> {
+    corner_starts(&built.maps, &common_box(&built.maps), &corner_args())
+}
+
+/// The demo's planning problem: from the south-west corner start to the south-east and
+/// north-east corners and to the open floor in front of the rack's middle (the north-west
+/// corner lies behind the rack's end, in a 0.96 m gap that the scans' mixed pixels narrow further:
+/// a narrow-passage benchmark, not a demo; the timing runs still start there).
+pub(super) fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, Vec<Point3>)> {
+    let (start, corners) = starts.split_first().context("no start")?;
+    let mut goals: Vec<Point3> = corners.iter().take(2).copied().collect();
+    let common = common_box(&built.maps);
+    let free = |p: &Point3| {
+        common.contains(p)
+            && built.maps.iter().all(|m| {
+                patch_core::CapsuleStep::sphere(*p, RADIUS)
+                    .is_ok_and(|s| patch_core::UnspecificStepIntersector::is_step_free(&m.map, &s))
+            })
+    };
+    // A small spiral around (4, 6.4, 1): in front of the rack, between its posts' rows.
+    let front = (0..6)
+        .flat_map(|ring| {
+            let r = 0.2 * f64::from(ring);
+            (0..8).map(move |k| {
+                let a = std::f64::consts::FRAC_PI_4 * f64::from(k);
+                Point3::new(4.0 + r * a.cos(), 6.4 + r * a.sin(), 1.0)
+            })
+        })
+        .find(|p| free(p))
+        .context("no free goal in front of the rack")?;
+    goals.push(front);
+    Ok((*start, goals))
+}
+
+/// The planning space of `map`: its own box (thesis L6460).
+fn space(map: &BuiltMap) -> Result<PlanningSpace> {
+    PlanningSpace::new(crate::map::map_bounds(&map.map), RADIUS, STEP)
+        .with_context(|| format!("the {} map's planning space", map.kind))
+}
+
+/// Runs RRT and PRM from `start` to `goal_points` ([`plan_points`]) on every map, `plan_seeds` seeds
+/// each, and writes the first seed's roadmap and paths (`roadmap-MAP-PLANNER.obj`,
+/// `path-MAP-PLANNER.obj`). Only the first seed's run carries its (decimated) roadmap edges
+/// for the pictures; the other runs have metrics and paths only.
+pub(super) fn plan_all(
+    built: &Built,
+    start: &Point3,
+    goal_points: &[Point3],
+    seed: u64,
+    settings: &Settings,
+    progress: &Progress,
+    files: &mut Files,
+) -> Result<Vec<PlanRun>> {
+    let goals: Vec<Goal> =
+        goal_points.iter().map(|&center| Goal { center, tolerance: GOAL_TOLERANCE }).collect();
+    let problem = Problem { start: *start, goals };
+    let bar =
+        progress.bar((built.maps.len() * PLANNERS.len()) as u64 * settings.plan_seeds, "planning");
+    let mut runs = Vec::new();
+    for m in &built.maps {
+        let space = space(m)?;
+        for choice in PLANNERS {
+            for s in 0..settings.plan_seeds {
+                let run_seed = seed.wrapping_add(s);
+                let mut run = planner(choice, &m.map, space, run_seed);
+                let t0 = Instant::now();
+                let status = run.solve(
+                    &problem,
+                    &mut AnyOf(GoalReached, MaxIterations(settings.plan_iterations)),
+                );
+                let seconds = t0.elapsed().as_secs_f64();
+                if status == PlannerStatus::InvalidStart {
+                    bail!("the start is not free on the {} map", m.kind);
+                }
+                let paths: Vec<Vec<Point3>> =
+                    (0..problem.goals.len()).filter_map(|g| run.path_to(g)).collect();
+                let metrics: Vec<PathMetrics> = paths.iter().map(|p| PathMetrics::of(p)).collect();
+                let angles: Vec<f64> = paths.iter().flat_map(|p| turn_angles(p)).collect();
+                let graph = run.roadmap();
+                let edges: Vec<[[f64; 3]; 2]> = graph
+                    .edge_indices()
+                    .filter_map(|e| graph.edge_endpoints(e))
+                    .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
+                    .collect();
+                let c = run.counters();
+                let name = run.name().to_owned();
+                if s == 0 {
+                    let file = format!("roadmap-{}-{name}.obj", m.kind);
+                    let points: Vec<Point3> = graph.node_weights().copied().collect();
+                    let lines = graph
+                        .edge_indices()
+                        .filter_map(|e| graph.edge_endpoints(e))
+                        .map(|(a, b)| vec![a.index(), b.index()]);
+                    write_obj_lines(&files.path(&file), &points, lines)?;
+                    files.add(
+                        format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
+                        &file,
+                    )?;
+                    let file = format!("path-{}-{name}.obj", m.kind);
+                    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
+                    let mut first = 0;
+                    let lines: Vec<Vec<usize>> = paths
+                        .iter()
+                        .map(|p| {
+                            let line = (first..first + p.len()).collect();
+                            first += p.len();
+                            line
+                        })
+                        .collect();
+                    write_obj_lines(&files.path(&file), &points, lines.into_iter())?;
+                    files.add(
+                        format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
+                        &file,
+                    )?;
+                }
+                runs.push(PlanRun {
+                    map: m.kind.name().to_owned(),
+                    backend: m.map.backend().to_owned(),
+                    planner: name,
+                    seed: run_seed,
+                    solved: paths.len() == problem.goals.len(),
+                    seconds,
+                    iterations: c.samples,
+                    vertices: c.vertices,
+                    collision_checks: c.collision_checks,
+                    path_length: metrics.iter().map(|m| m.length).sum(),
+                    turns: metrics.iter().map(|m| m.turns).sum(),
+                    steep_turns: metrics.iter().map(|m| m.steep_turns).sum(),
+                    curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
+                    start: p3(start),
+                    goals: goal_points.iter().map(p3).collect(),
+                    paths: paths.iter().map(|p| p.iter().map(p3).collect()).collect(),
+                    edges: if s == 0 { decimate(&edges, MAX_DRAWN) } else { Vec::new() },
+                });
+                bar.inc(1);
+            }
+        }
+    }
+    bar.finish_and_clear();
+    Ok(runs)
+}
+
+/// Grows RRTs (thesis Algorithm 13, no goal) from the first `timing_starts` corners with
+/// `timing_seeds` seeds on every map, timed at checkpoints (Fig 6.4: median and quartiles per
+/// map type), and rasterises each map type's explored space (every edge, every free vertex)
+/// into one voxel grid covering all maps: the congruence table (Table 6.2) and a horizontal
+/// slice at the start height (Fig 6.1).
+pub(super) fn timing_and_volume(
+    built: &Built,
+    starts: &[Point3],
+    seed: u64,
+    settings: &Settings,
+    progress: &Progress,
+) -> Result<(Vec<TimingCurve>, VolumeSection)> {
+    let cps = checkpoints(settings.iterations, settings.checkpoints);
+    let bounds: Vec<_> = built.maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
+    let all = bounds.iter().fold(pointcloud::Aabb::EMPTY, |a, b| a.union(b));
+    let empty = VoxelGrid::covering(bounds, settings.cells)?;
+    let starts = &starts[..settings.timing_starts.min(starts.len())];
+    let bar = progress
+        .bar((built.maps.len() * starts.len()) as u64 * settings.timing_seeds, "rrt timing");
+    let mut curves = Vec::new();
+    let mut grids = Vec::new();
+    for m in &built.maps {
+        let space = space(m)?;
+        let mut grid = empty.empty_like();
+        let mut runs: Vec<Vec<f64>> = Vec::new();
+        for &start in starts {
+            for s in 0..settings.timing_seeds {
+                let mut rrt = Rrt::new(&m.map, space, RrtConfig::thesis(), seed.wrapping_add(s));
+                let mut timer = CheckpointTimer::new(cps.clone());
+                let status = rrt.solve(&Problem { start, goals: Vec::new() }, &mut timer);
+                if status == PlannerStatus::InvalidStart {
+                    bail!("a start is not free on the {} map", m.kind);
+                }
+                if timer.seconds.len() != cps.len() {
+                    bail!("an RRT on the {} map stopped early", m.kind);
+                }
+                runs.push(timer.seconds);
+                grid.add_roadmap(&explored(rrt.roadmap(), &m.map, RADIUS)?, RADIUS)?;
+                bar.inc(1);
+            }
+        }
+        let q = |c: usize, p: f64| {
+            let v: Vec<f64> = runs.iter().map(|r| r[c]).collect();
+            quantile(&v, p).unwrap_or(f64::NAN) * 1e3
+        };
+        curves.push(TimingCurve {
+            map: m.kind.name().to_owned(),
+            iterations: cps.clone(),
+            median_ms: (0..cps.len()).map(|c| q(c, 0.5)).collect(),
+            q1_ms: (0..cps.len()).map(|c| q(c, 0.25)).collect(),
+            q3_ms: (0..cps.len()).map(|c| q(c, 0.75)).collect(),
+        });
+        grids.push(grid);
+    }
+    bar.finish_and_clear();
+    let names: Vec<&str> = built.maps.iter().map(|m| m.kind.name()).collect();
+    let table = CongruenceTable::new(names.iter().copied().zip(&grids))?;
+    let n = names.len();
+    let volumes_m3: Vec<f64> = (0..n).map(|i| table.volume(i)).collect();
+    let table: Vec<Vec<Option<f64>>> =
+        (0..n).map(|i| (0..n).map(|j| table.percent_not_in(i, j)).collect()).collect();
+    // The slice: the layer of cells holding the first start's height, over the maps' box.
+    let (min, cell, cells) = (empty.min(), empty.cell_size(), empty.cells_per_axis());
+    let z = starts.first().map_or(all.min.z, |s| s.z);
+    let k = (((z - min.z) / cell).floor().max(0.0) as u32).min(cells - 1);
+    let span = |lo: f64, hi: f64| (((hi - lo) / cell).ceil() as u32).clamp(1, cells);
+    let (nx, ny) = (span(min.x, all.max.x), span(min.y, all.max.y));
+    let mut bits = Vec::with_capacity((nx * ny) as usize);
+    for j in 0..ny {
+        for i in 0..nx {
+            let b = grids
+                .iter()
+                .enumerate()
+                .fold(0u8, |b, (g, grid)| b | (u8::from(grid.contains(i, j, k)) << g));
+            bits.push(b);
+        }
+    }
+    let volume = VolumeSection {
+        cell,
+        maps: names.iter().map(|s| (*s).to_owned()).collect(),
+        volumes_m3,
+        table,
+        slice_z: empty.cell_center(0, 0, k).z,
+        slice_origin: [min.x, min.y],
+        slice_size: [nx, ny],
+        slice_bits: bits,
+    };
+    Ok((curves, volume))
+}
