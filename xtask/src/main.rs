@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod bench;
+mod compare;
 mod fixtures;
 mod peers;
 mod provenance;
@@ -74,6 +75,7 @@ fn try_main() -> Result<()> {
         }
         "bench" => bench::run(rest),
         "peers" => peers::run(rest),
+        "compare" => compare::run(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
             Ok(())

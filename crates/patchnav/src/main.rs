@@ -29,6 +29,7 @@ mod map;
 mod plan;
 mod problem;
 mod progress;
+mod run_config;
 mod scene_map;
 mod simulate;
 mod terrain;
@@ -67,6 +68,9 @@ enum Command {
     /// The main job on the built-in example: simulate the lab, filter a ToF frame, classify
     /// terrain, extract patches, build every map, plan on each, and write an HTML report.
     Demo(demo::DemoArgs),
+    /// The demo's job on your own data (scans + poses, a mesh, or a map file) described by a
+    /// TOML file.
+    Run(run_config::RunArgs),
     /// Scan a synthetic scene with a simulated sensor from several poses.
     Simulate(simulate::SimulateArgs),
     /// Planar (and trimesh) patches from range scans, merged across scans, as a map file.
@@ -95,6 +99,7 @@ fn main() -> ExitCode {
             convert::run(&input, &output, &options, &progress)
         }
         Command::Demo(args) => demo::run(&args, &progress),
+        Command::Run(args) => run_config::run(&args, &progress),
         Command::Simulate(args) => simulate::run(&args, &progress),
         Command::Extract(args) => extract::run(&args, &progress),
         Command::Map(command) => map::run(&command, &progress),
