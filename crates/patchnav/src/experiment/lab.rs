@@ -247,7 +247,11 @@ fn build_lab(args: &LabMapArgs, progress: &Progress) -> Result<Lab> {
 
 /// The first point free on every map (and inside every map's box) on a spiral of candidates
 /// from 0.6 m inside each room corner at 1.0 m height; `args.starts` of them.
-pub(crate) fn corner_starts(maps: &[BuiltMap], common: &Aabb, args: &LabMapArgs) -> Result<Vec<Point3>> {
+pub(crate) fn corner_starts(
+    maps: &[BuiltMap],
+    common: &Aabb,
+    args: &LabMapArgs,
+) -> Result<Vec<Point3>> {
     let [lx, ly, _] = scene_sim::lab_layout::ROOM;
     let corners =
         [(0.0, 0.0, 1.0, 1.0), (lx, 0.0, -1.0, 1.0), (lx, ly, -1.0, -1.0), (0.0, ly, 1.0, -1.0)];
