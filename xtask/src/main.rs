@@ -5,6 +5,9 @@
 //! * `cargo xtask bench [NAME ...] [--seed N] [--out FILE]`: runs named benchmarks of the
 //!   `bench-matrix` program in release mode and appends one JSON line per measurement, with the
 //!   provenance of the run (git revision, host, CPU, date, seed), to `target/bench/results.jsonl`.
+//! * `cargo xtask bench roadmap [--scene S] [--backend B] [--planner P] [--seeds N] [--jobs N]
+//!   [--resume]`: the planning matrix; also OMPL benchmark logs in `target/bench/ompl/`.
+//! * `cargo xtask docs [--results F] [--out F]`: generates `docs/benchmarks.md` from the results.
 //! * `cargo xtask peers planes [--peers-dir DIR] [--peers-build DIR] [--bench-dir DIR] [--out F]`:
 //!   our plane extraction beside PCL's and Open3D's on the shared floor-plan clouds, one process
 //!   per run, quality against the floor plan's mesh; JSONL rows to `target/peers/planes.jsonl`
@@ -12,6 +15,10 @@
 //! * `cargo xtask peers terrain [--peers-dir DIR] [--peers-build DIR] [--out F]`: our Hough
 //!   terrain classification beside one RANSAC ground-plane fit of PCL and Open3D on the same
 //!   frames, ratio ours/theirs (docs/terrain.md).
+//! * `cargo xtask compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]`:
+//!   OMPL + FCL planners, OctoMap and PCL segmentation built from `compare/` beside ours on the
+//!   same inputs in one run, ratios ours/theirs; JSONL rows to `target/compare/`
+//!   (docs/comparison.md).
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -19,7 +26,9 @@ use std::process::ExitCode;
 
 mod bench;
 mod compare;
+mod docs_gen;
 mod fixtures;
+mod ompl_log;
 mod peers;
 mod provenance;
 
@@ -30,10 +39,17 @@ commands:
   fixtures [--check]                    regenerate fixtures/ (or check they are current)
   bench [NAME ...] [--seed N] [--out F] run named benchmarks (default: all), append JSONL rows
   bench --list                          list the benchmark names
+  bench roadmap [--scene S] [--backend B] [--planner P] [--seeds N] [--jobs N] [--resume]
+                                        the planning matrix (scenes x backends x planners x seeds);
+                                        --resume skips cases already in the results for this git
+                                        revision; also writes OMPL logs to target/bench/ompl/
+  docs [--results F] [--out F]          generate docs/benchmarks.md (and docs/img/) from the results
   peers planes [--peers-dir D] [--peers-build D] [--bench-dir D] [--out F]
                                         our plane extraction beside PCL and Open3D (same inputs)
   peers terrain [--peers-dir D] [--peers-build D] [--out F]
                                         Hough terrain classes beside a RANSAC ground plane (PCL, Open3D)
+  compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]
+                                        OMPL+FCL, OctoMap, PCL (built from compare/) beside ours
 ";
 
 fn main() -> ExitCode {
@@ -74,6 +90,7 @@ fn try_main() -> Result<()> {
             Ok(())
         }
         "bench" => bench::run(rest),
+        "docs" => docs_gen::run(rest),
         "peers" => peers::run(rest),
         "compare" => compare::run(rest),
         "help" | "--help" | "-h" => {

@@ -361,7 +361,7 @@ impl Plane {
 }
 
 /// The floor plan's triangles, their distinct planes, and which planes each cloud shows.
-struct Truth {
+pub(crate) struct Truth {
     triangles: Vec<[Point3; 3]>,
     /// Plane index of each triangle.
     plane_of: Vec<usize>,
@@ -371,7 +371,7 @@ struct Truth {
 }
 
 impl Truth {
-    fn load(bench: &Path) -> Result<Truth> {
+    pub(crate) fn load(bench: &Path) -> Result<Truth> {
         let mesh = pointcloud::io::read_mesh(&bench.join("floorplan.obj"))?;
         let v = mesh.vertices();
         let triangles: Vec<[Point3; 3]> = mesh
@@ -426,7 +426,7 @@ impl Truth {
     }
 
     /// Quality of a run's polygons JSON on `cloud` (see the module docs).
-    fn quality(&self, cloud: &str, polygons: &Value) -> Value {
+    pub(crate) fn quality(&self, cloud: &str, polygons: &Value) -> Value {
         let planes = polygons.get("planes").and_then(Value::as_array).cloned().unwrap_or_default();
         let visible = self.visible(cloud);
         let mut found = vec![false; self.planes.len()];

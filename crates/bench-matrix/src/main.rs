@@ -18,37 +18,58 @@ use scene_sim::{Alrf, RangeCamera, RangeSensor, StereoCamera, scene_by_name};
 use serde_json::{Value, json};
 use std::time::Instant;
 
+mod roadmap;
 mod terrain;
 
-/// A named benchmark: a function of the seed giving result rows.
+/// Receives the rows of a matrix benchmark as they come.
+type Emit<'a> = &'a mut dyn FnMut(Value) -> Result<()>;
+
+/// How a benchmark runs.
+enum Run {
+    /// A function of the seed giving all its rows at the end.
+    Rows(fn(u64) -> Result<Vec<Value>>),
+    /// A matrix of cases: takes the selection (`--scene`, `--backend`, `--planner`, `--seeds`,
+    /// `--jobs`, `--resume`) and hands over the rows of each case as it finishes, so an
+    /// interrupted run keeps what it did.
+    Matrix(fn(&roadmap::MatrixArgs, Emit<'_>) -> Result<()>),
+}
+
+/// A named benchmark.
 struct Bench {
     name: &'static str,
     about: &'static str,
-    run: fn(u64) -> Result<Vec<Value>>,
+    run: Run,
 }
 
 const BENCHES: &[Bench] = &[
     Bench {
         name: "raycast",
         about: "simulated scans of the lab: full ALRF (195,301 beams), range camera, stereo camera",
-        run: raycast,
+        run: Run::Rows(raycast),
     },
     Bench {
         name: "io",
         about: "write and read a full ALRF scan in PLY (binary, ascii), PCD (binary, compressed), XYZ",
-        run: io,
+        run: Run::Rows(io),
     },
     Bench {
         name: "tof",
         about: "Table 2.4: AT 160/240, AAT, AAT+unwrap, two-frequency, AAT+unwrap+spatial on six simulated \
                 scenes and a folded real frame; AAT speed",
-        run: tof,
+        run: Run::Rows(tof),
     },
     Bench {
         name: "terrain",
         about: "Tables 4.3, 4.6, 4.7: Hough terrain classes and drivability on simulated snapshots and real \
                 frames; votes per second against the literal Algorithm 2",
-        run: terrain::run,
+        run: Run::Rows(terrain::run),
+    },
+    Bench {
+        name: "roadmap",
+        about: "Tables 5.3-5.11, Fig 6.4: scenes (office, lab) x backends x planners x seeds; \
+                --scene, --backend, --planner (repeatable or comma-separated), --seeds N, --jobs N, \
+                --resume FILE (case keys to skip, one a line)",
+        run: Run::Matrix(roadmap::run),
     },
 ];
 
@@ -62,9 +83,43 @@ fn main() {
 fn try_main() -> Result<()> {
     let mut seed = 0u64;
     let mut names = Vec::new();
+    let mut matrix = roadmap::MatrixArgs {
+        scenes: Vec::new(),
+        backends: Vec::new(),
+        planners: Vec::new(),
+        seed: 0,
+        seeds: 10,
+        jobs: 1,
+        skip: Default::default(),
+    };
     let mut args = std::env::args().skip(1);
+    let list =
+        |v: String| v.split(',').filter(|s| !s.is_empty()).map(str::to_owned).collect::<Vec<_>>();
     while let Some(a) = args.next() {
         match a.as_str() {
+            "--scene" => matrix.scenes.extend(list(args.next().context("--scene needs a name")?)),
+            "--backend" => {
+                matrix.backends.extend(list(args.next().context("--backend needs a name")?))
+            }
+            "--planner" => {
+                matrix.planners.extend(list(args.next().context("--planner needs a name")?))
+            }
+            "--seeds" => {
+                let v = args.next().context("--seeds needs a value")?;
+                matrix.seeds = v.parse().with_context(|| format!("bad --seeds `{v}`"))?;
+            }
+            "--jobs" => {
+                let v = args.next().context("--jobs needs a value")?;
+                matrix.jobs = v.parse().with_context(|| format!("bad --jobs `{v}`"))?;
+            }
+            "--resume" => {
+                let path = args.next().context("--resume needs a file")?;
+                let text =
+                    std::fs::read_to_string(&path).with_context(|| format!("reading {path}"))?;
+                matrix.skip.extend(
+                    text.lines().map(str::trim).filter(|l| !l.is_empty()).map(str::to_owned),
+                );
+            }
             "--list" => {
                 for b in BENCHES {
                     println!("{:<10} {}", b.name, b.about);
@@ -84,13 +139,28 @@ fn try_main() -> Result<()> {
             bail!("unknown benchmark `{n}`; known: {}", known.join(", "));
         }
     }
+    matrix.seed = seed;
     for b in BENCHES.iter().filter(|b| names.is_empty() || names.iter().any(|n| n == b.name)) {
-        for mut row in (b.run)(seed).with_context(|| format!("benchmark `{}`", b.name))? {
+        let mut emit = |mut row: Value| -> Result<()> {
+            use std::io::Write as _;
             if let Some(obj) = row.as_object_mut() {
                 obj.insert("bench".into(), b.name.into());
                 obj.insert("tool".into(), concat!("patchnav-", env!("CARGO_PKG_VERSION")).into());
             }
-            println!("{row}");
+            let mut out = std::io::stdout().lock();
+            writeln!(out, "{row}")?;
+            out.flush()?;
+            Ok(())
+        };
+        match &b.run {
+            Run::Rows(run) => {
+                for row in run(seed).with_context(|| format!("benchmark `{}`", b.name))? {
+                    emit(row)?;
+                }
+            }
+            Run::Matrix(run) => {
+                run(&matrix, &mut emit).with_context(|| format!("benchmark `{}`", b.name))?
+            }
         }
     }
     Ok(())

@@ -108,7 +108,7 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
 }
 
 /// Reads a `poses.json`: file name → `world_from_sensor`.
-fn read_poses(path: &Path) -> Result<HashMap<String, Isometry3>> {
+pub(crate) fn read_poses(path: &Path) -> Result<HashMap<String, Isometry3>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let v: Value =

@@ -326,7 +326,17 @@ pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Re
                 }
                 Err(reason) => skipped_row(&p, choice, map.backend(), args.mode, seed, &reason),
             };
-            bar.suspend(|| println!("{row}"));
+            // A closed pipe (`| head`) ends the run quietly instead of panicking in println!.
+            let written = bar.suspend(|| {
+                use std::io::Write as _;
+                let mut out = std::io::stdout().lock();
+                writeln!(out, "{row}").and_then(|()| out.flush())
+            });
+            match written {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => return Ok(()),
+                Err(e) => return Err(e).context("writing a result row"),
+            }
             bar.inc(1);
         }
     }

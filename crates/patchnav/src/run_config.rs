@@ -1,16 +1,178 @@
-//! `patchnav run CONFIG.toml` (being written).
+//! `patchnav run CONFIG.toml`: the demo's job (`patchnav demo`) on the user's own data. Reads
+//! scans with their poses, a mesh, a map file or a point cloud; builds the map types of thesis
+//! Table 6.1 that the input allows in the chosen backends; plans with the chosen planners and
+//! seeds from one start to the goals on every map; optionally filters a time-of-flight frame
+//! (AAT + unwrapping, thesis §2.5) and classifies a terrain frame (plane Hough transform,
+//! Ch. 4); and writes `results.json`, `report.html` (the demo's report; the RRT timing and
+//! explored-volume sections read "not computed") and the 3D files into the output folder, with
+//! a summary on standard output.
+//!
+//! # The configuration file
+//!
+//! TOML; unknown keys are errors; paths are relative to the configuration file's folder.
+//! `docs/run.md` has a complete example.
+//!
+//! | key | default | meaning |
+//! |---|---|---|
+//! | `input.scans` | — | scan files in their sensor frames (`.ply .pcd .3d .bin .xyz .png`); exactly one of `scans`, `mesh`, `map`, `cloud` |
+//! | `input.poses` | each scan's own pose (PLY/PCD header, 3DTK `.pose`) | a `poses.json` as `patchnav simulate` writes and `patchnav extract --poses` reads, matched by file name |
+//! | `input.mesh` | — | an OBJ mesh: coplanar faces become planar patches, the rest trimesh patches |
+//! | `input.map` | — | a map file (`.pmap`) of any backend |
+//! | `input.cloud` | — | a point cloud in the world frame (the `pc` map) |
+//! | `input.name` | the configuration file's stem | the data set's name in the report |
+//! | `input.skip_non_finite` | `false` | drop NaN points of unorganised clouds instead of failing |
+//! | `maps.types` | all the input allows: scans `planes hybrid trimesh pc`, mesh `planes hybrid pc`, map file its own type, cloud `pc` | map types to build |
+//! | `maps.backends` | `["trimesh"]` (a map file: its own backend) | backends each patch map is loaded into (`polygon bbox6d trimesh rapier`); one Table 6.1 row and one set of planning runs per backend; the `pc` map is always `pointcloud` |
+//! | `maps.sensor` | `"alrf"` | extraction presets for scans: `alrf`, `range-camera`, `exact` |
+//! | `maps.spacing` | `0.05` | mesh input: sample spacing of its `pc` map, metres |
+//! | `plan.start` | — (required) | `[x, y, z]`, metres; must be free on every map |
+//! | `plan.goals` | — (required) | `[[x, y, z], ...]` |
+//! | `plan.radius` | `0.3` | robot radius, metres |
+//! | `plan.step` | `1.0` | longest RRT edge, metres |
+//! | `plan.goal_tolerance` | `0.5` | how close a vertex must come to a goal, metres |
+//! | `plan.planners` | `["rrt", "prm"]` | any planner of `patchnav plan` (`rrt prm prm-star lazy-prm rrt-star rrt-connect evasion-rrt ma-prm ma-rrt`) |
+//! | `plan.seeds` | `[1]` | seeds; every planner runs once per seed on every map |
+//! | `plan.max_iterations` | `10000` | iteration budget of a run (it stops once every goal is reached) |
+//! | `tof.range`, `tof.amplitude`, `tof.meta` | — (required in `[tof]`) | a 16-bit PNG pair and its JSON sidecar, as `patchnav tof filter` reads |
+//! | `tof.confidence` | none | optional confidence PNG |
+//! | `tof.aat` | the sidecar's (thesis: 0.2) | AAT threshold |
+//! | `tof.unwrap` | `true` | unwrap the flagged pixels instead of dropping them |
+//! | `tof.low_at` | none | with `unwrap`: drop flagged pixels with amplitude ≤ this |
+//! | `terrain.frame` | — (required in `[terrain]`) | a range frame, as `patchnav terrain` reads |
+//! | `terrain.resolution` | `15.0` | Hough angular resolution, degrees |
+//! | `terrain.sensor_height` | `0.45` | metres above the floor |
+//! | `terrain.pitch` | `0.0` | degrees down from level |
+//! | `terrain.axes` | camera for organised frames, lidar otherwise | `camera` or `lidar` |
+//! | `terrain.max_range` | none | keep points within this horizontal range, metres |
+//! | `terrain.sectors` | `3` | azimuth sectors of the ±45° forward view |
+//! | `output.dir` | `"out/run"` | output folder |
+//! | `output.write_3d` | `true` | write the map meshes, roadmaps, paths and the ToF cloud |
+//!
+//! # Choices
+//! * Planning uses `patchnav plan`'s planners ([`crate::plan::make_planner`]: every planner
+//!   tests the direct step to a goal after each vertex, thesis §6.2.3), each map sampled in its
+//!   own box (thesis L6460), stopping when every goal is reached or the budget is spent.
+//! * Planners that need a patch map (`evasion-rrt`, `ma-prm`, `ma-rrt`, thesis Table 5.2) are
+//!   skipped on the `pc` map, with a line in the summary.
+//! * Without a simulation's truth, the ToF section's wrapped / unwrapped-correctly / wrong
+//!   percentages and the terrain's true class are unknown.
+
+mod config;
+mod pipeline;
+
+pub use config::{Config, Input, load};
 
 use crate::progress::Progress;
-use anyhow::{Result, bail};
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
 
 /// Arguments of `patchnav run`.
 #[derive(Debug, clap::Args)]
 pub struct RunArgs {
-    /// The configuration file.
+    /// The configuration file (TOML; see `docs/run.md`).
     pub config: std::path::PathBuf,
 }
 
 /// Runs `patchnav run`.
-pub fn run(_args: &RunArgs, _progress: &Progress) -> Result<()> {
-    bail!("run is not built yet")
+///
+/// # Errors
+/// A bad configuration (one line naming the key), or a stage failing.
+pub fn run(args: &RunArgs, progress: &Progress) -> Result<()> {
+    let config = load(&args.config)?;
+    std::fs::create_dir_all(&config.out)
+        .with_context(|| format!("output.dir: creating {}", config.out.display()))?;
+    let (results, skipped) = pipeline::run(&config, progress)?;
+    let json = config.out.join("results.json");
+    std::fs::write(&json, serde_json::to_string(&results)? + "\n")
+        .with_context(|| format!("writing {}", json.display()))?;
+    let html = config.out.join("report.html");
+    crate::demo::report::write(&results, &html)
+        .with_context(|| format!("writing {}", html.display()))?;
+    progress.say(summary(&config, &results, &skipped)?.trim_end());
+    progress.report(format!("report: {}", html.display()));
+    Ok(())
+}
+
+/// The summary printed on standard output.
+fn summary(
+    config: &Config,
+    r: &crate::demo::model::DemoResults,
+    skipped: &[String],
+) -> Result<String> {
+    let mut out = String::new();
+    let what = match &config.input {
+        Input::Scans { files, poses } => format!(
+            "{} scans, {} points, poses {}",
+            files.len(),
+            r.scene.points,
+            poses.as_ref().map_or("from the scans".to_owned(), |p| format!("from {}", p.display()))
+        ),
+        Input::Mesh(p) => format!("mesh {}", p.display()),
+        Input::Map(p) => format!("map file {}", p.display()),
+        Input::Cloud(p) => format!("cloud {}, {} points", p.display(), r.scene.points),
+    };
+    writeln!(out, "{}: {what}", config.name)?;
+    if let Some(t) = &r.tof {
+        writeln!(
+            out,
+            "tof: {} on {}×{}: {:.1} % discarded, {:.1} ms",
+            t.method, t.width, t.height, t.discarded_percent, t.millis
+        )?;
+    }
+    if let Some(t) = &r.terrain {
+        writeln!(
+            out,
+            "terrain: {} ({}), sectors {}",
+            t.class,
+            if t.drivable { "drivable" } else { "not drivable" },
+            t.sectors.iter().map(|(c, _)| c.as_str()).collect::<Vec<_>>().join(" / ")
+        )?;
+    }
+    writeln!(out, "maps:")?;
+    for m in &r.maps {
+        let held = if m.points > 0 {
+            format!("{} points", m.points)
+        } else {
+            format!(
+                "{} planar + {} trimesh patches, {} triangles",
+                m.planar_patches, m.trimesh_patches, m.triangles
+            )
+        };
+        writeln!(
+            out,
+            "  {:<8} {:<10} {held}, {:.1} MB, built in {:.2} s",
+            m.kind,
+            m.backend,
+            m.memory_bytes as f64 / 1e6,
+            m.build_seconds
+        )?;
+    }
+    writeln!(out, "plans (radius {} m, goals: {}):", config.plan.radius, config.plan.goals.len())?;
+    for p in &r.plans {
+        writeln!(
+            out,
+            "  {:<8} {:<10} {:<12} seed {:<3} {}  {:.2} m, {} samples, {:.3} s",
+            p.map,
+            p.backend,
+            p.planner,
+            p.seed,
+            if p.solved { "solved  " } else { "unsolved" },
+            p.path_length,
+            p.iterations,
+            p.seconds
+        )?;
+    }
+    for line in skipped {
+        writeln!(out, "  {line}")?;
+    }
+    let stages: Vec<String> =
+        r.stages.iter().map(|s| format!("{} {:.2} s", s.stage, s.seconds)).collect();
+    writeln!(out, "time: {}", stages.join(", "))?;
+    writeln!(
+        out,
+        "wrote {} files and results.json into {}",
+        r.files.len() + 1,
+        config.out.display()
+    )?;
+    Ok(out)
 }

@@ -67,8 +67,32 @@ pub struct TerrainArgs {
     pub input: InputArgs,
 }
 
-/// Runs `patchnav terrain`.
-pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
+/// A frame classified by [`classify`]: what `patchnav terrain` prints (and `patchnav run`
+/// reports).
+pub(crate) struct Classified {
+    /// Points in the frame.
+    pub(crate) cloud_points: usize,
+    /// The points voted (the forward view, if cut).
+    pub(crate) points: Vec<Point3>,
+    /// The axes used.
+    pub(crate) axes: AxesChoice,
+    /// The whole view's classification.
+    pub(crate) result: Classification,
+    /// Median classification time, seconds.
+    pub(crate) seconds: f64,
+    /// The classifier, holding the last run's Hough space.
+    pub(crate) classifier: HoughClassifier,
+    /// The per-sector classifications (empty without `--sectors`).
+    pub(crate) sectors: Vec<hough_terrain::Sector>,
+}
+
+/// Checks the arguments, reads the frame, classifies it (`repeat` times), writes the Hough PNG
+/// if asked, and classifies the sectors.
+///
+/// # Errors
+/// A parameter out of range, an unreadable or empty frame, no point ahead, or a classifier
+/// refusing its input.
+pub(crate) fn classify(args: &TerrainArgs) -> Result<Classified> {
     ensure!(
         args.resolution.is_finite() && args.resolution > 0.0 && args.resolution <= 90.0,
         "--resolution must be in (0, 90] degrees, not {}",
@@ -149,6 +173,13 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
         None => Vec::new(),
     };
 
+    Ok(Classified { cloud_points: cloud.len(), points, axes, result, seconds, classifier, sectors })
+}
+
+/// Runs `patchnav terrain`.
+pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
+    let Classified { cloud_points, points, axes, result, seconds, classifier, sectors } =
+        classify(args)?;
     if args.json {
         let sectors: Vec<_> = sectors
             .iter()
@@ -161,7 +192,7 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
             serde_json::json!({"rho_x_deg": p.rho_x.to_degrees(), "rho_y_deg": p.rho_y.to_degrees(), "d": p.d})
         });
         let row = serde_json::json!({
-            "frame": args.frame.display().to_string(), "points": cloud.len(), "points_used": points.len(),
+            "frame": args.frame.display().to_string(), "points": cloud_points, "points_used": points.len(),
             "resolution_deg": args.resolution, "class": class_name(&result), "drivable": result.drivable,
             "accepted": result.accepted, "rule": format!("{:?}", result.rule), "plane": plane,
             "votes": result.votes, "high_bins": result.high_bins, "time_ms": seconds * 1e3, "repeat": args.repeat,
@@ -174,7 +205,7 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
     progress.report(format!(
         "frame:     {} ({} points, {} used; {:?} axes, {} m up, pitched {}° down)",
         args.frame.display(),
-        cloud.len(),
+        cloud_points,
         points.len(),
         axes,
         args.sensor_height,

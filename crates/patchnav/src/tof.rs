@@ -206,7 +206,13 @@ fn load_frame(args: &FrameArgs, cloud: Option<&Path>) -> Result<(TofFrame, Frame
     Ok((frame, meta))
 }
 
-fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
+/// Reads the frame the arguments name and filters it as `--method` says: the frame, the
+/// filter's output and the method's name (e.g. `AAT 0.2`).
+///
+/// # Errors
+/// An unreadable frame or sidecar, no AAT parameters for `--method aat`, a parameter out of
+/// range, or the filter refusing the frame.
+pub(crate) fn filter_frame(args: &FilterArgs) -> Result<(TofFrame, FilterOutput, String)> {
     let (frame, meta) = load_frame(&args.frame, args.cloud.as_deref())?;
     let (output, name) = match args.method {
         Method::At => {
@@ -288,6 +294,11 @@ fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
             (out, name)
         }
     };
+    Ok((frame, output, name))
+}
+
+fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
+    let (frame, output, name) = filter_frame(args)?;
     let mut written = output.clone();
     if args.safe {
         for (o, r) in written.outcomes.iter_mut().zip(written.radial.iter_mut()) {

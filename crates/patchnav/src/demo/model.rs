@@ -25,6 +25,9 @@ pub enum Scale {
 /// Everything the demo measured.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct DemoResults {
+    /// The command that produced it (`demo` or `run`), for the report's title.
+    #[serde(default)]
+    pub command: String,
     /// The scale it ran at.
     pub scale: Option<Scale>,
     /// The seed of everything random.

@@ -31,7 +31,7 @@
 //!   a goal only by a sample within the tolerance, often misses: such runs are reported
 //!   unsolved, with the paths to the goals they reached.
 
-mod maps;
+pub(crate) mod maps;
 mod planning;
 mod sensors;
 
@@ -120,11 +120,12 @@ impl Settings {
 /// The files written so far, with their sizes.
 pub(crate) struct Files {
     out: PathBuf,
-    entries: Vec<FileEntry>,
+    pub(crate) entries: Vec<FileEntry>,
 }
 
 impl Files {
-    fn new(out: &Path) -> Files {
+    /// No files yet, in the folder `out`.
+    pub(crate) fn new(out: &Path) -> Files {
         Files { out: out.to_owned(), entries: Vec::new() }
     }
 
@@ -144,18 +145,19 @@ impl Files {
 }
 
 /// Wall time of each stage.
-struct Clock {
-    stages: Vec<StageTime>,
+pub(crate) struct Clock {
+    pub(crate) stages: Vec<StageTime>,
     t0: Instant,
 }
 
 impl Clock {
-    fn new() -> Clock {
+    /// Starts the first stage.
+    pub(crate) fn new() -> Clock {
         Clock { stages: Vec::new(), t0: Instant::now() }
     }
 
     /// Ends the current stage as `stage`.
-    fn lap(&mut self, stage: &str) {
+    pub(crate) fn lap(&mut self, stage: &str) {
         self.stages
             .push(StageTime { stage: stage.to_owned(), seconds: self.t0.elapsed().as_secs_f64() });
         self.t0 = Instant::now();
@@ -268,6 +270,7 @@ pub fn run(scale: Scale, seed: u64, out: &Path, progress: &Progress) -> Result<D
         points: lab.points,
     };
     Ok(DemoResults {
+        command: "demo".to_owned(),
         scale: Some(scale),
         seed,
         stages: clock.stages,

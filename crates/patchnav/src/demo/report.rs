@@ -86,9 +86,10 @@ pub fn render(results: &DemoResults) -> String {
         page,
         "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>patchnav demo: {0}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n<main>\n\
-         <h1>patchnav demo: {0}</h1>\n<nav><ol>",
-        esc(&scene)
+         <title>patchnav {1}: {0}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n<main>\n\
+         <h1>patchnav {1}: {0}</h1>\n<nav><ol>",
+        esc(&scene),
+        esc(if results.command.is_empty() { "demo" } else { &results.command })
     );
     for (i, title) in SECTIONS.iter().enumerate() {
         let _ = write!(page, "<li><a href=\"#s{}\">{}</a></li>", i + 1, esc(&title[3..]));
@@ -695,6 +696,16 @@ fn section_terrain(t: Option<&TerrainSection>) -> String {
 fn section_tof(t: Option<&TofSection>) -> String {
     let mut out = String::new();
     let ours = t.map_or(String::new(), |t| {
+        if !t.wrapped_percent.is_finite() {
+            // A real frame: no truth to score against.
+            return format!(
+                " Here {} on the frame {} discards {} % of the pixels (no ground truth to tell \
+                 right from wrong).",
+                t.method,
+                t.scene,
+                fixed(t.discarded_percent, 1)
+            );
+        }
         format!(
             " Here {} on the simulated {} scene discards {} % of the pixels; {} % of the pixels were \
              wrapped, {} % of those are put back within 5 cm, and {} % of the output is wrong.",
@@ -845,6 +856,7 @@ mod tests {
     fn synthetic() -> DemoResults {
         let maps = ["planes", "hybrid", "trimesh", "pc"];
         DemoResults {
+            command: "demo".into(),
             scale: Some(Scale::Quick),
             seed: 7,
             stages: vec![

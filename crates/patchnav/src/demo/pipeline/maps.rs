@@ -5,7 +5,7 @@
 use super::{
     Files, MAX_DRAWN, SCAN_HEIGHT, Settings, decimate, p3mm, write_mesh_f32, write_ply_f32,
 };
-use crate::demo::model::{MapDrawing, MapRow};
+use crate::demo::model::{MapDrawing, MapRow, P3};
 use crate::progress::Progress;
 use crate::scene_map::{
     BuiltMap, MapKind, PatchBackend, ScanSetup, extracted_patches, patch_map, planar_triangles,
@@ -70,9 +70,52 @@ pub(crate) struct Built {
     pub(crate) drawings: Vec<MapDrawing>,
 }
 
+/// Simplifies `triangles` by vertex clustering for the pictures: vertices snapped to the centre
+/// of mass of their cell of a cubic grid, collapsed and repeated triangles dropped, the cell
+/// doubled from 5 cm until at most `budget` remain (then thinned evenly). A coarse but complete
+/// surface, unlike every n-th triangle.
+fn cluster_triangles(triangles: &[[P3; 3]], budget: usize) -> Vec<[P3; 3]> {
+    use std::collections::{HashMap, HashSet};
+    let mut cell = 0.05;
+    loop {
+        let key = |q: &P3| q.map(|c| (c / cell).floor() as i64);
+        let mut sums: HashMap<[i64; 3], ([f64; 3], f64)> = HashMap::new();
+        for q in triangles.iter().flatten() {
+            let e = sums.entry(key(q)).or_insert(([0.0; 3], 0.0));
+            (0..3).for_each(|i| e.0[i] += q[i]);
+            e.1 += 1.0;
+        }
+        let mut seen = HashSet::new();
+        let mut out = Vec::new();
+        for t in triangles {
+            let k = t.map(|q| key(&q));
+            if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
+                continue;
+            }
+            let mut sorted = k;
+            sorted.sort();
+            if seen.insert(sorted) {
+                out.push(k.map(|c| {
+                    let (sum, n) = sums[&c];
+                    p3mm_raw(sum.map(|v| v / n))
+                }));
+            }
+        }
+        if out.len() <= budget || cell > 5.0 {
+            return decimate(&out, budget);
+        }
+        cell *= 2.0;
+    }
+}
+
+/// Rounds to millimetres, as [`p3mm`] does.
+fn p3mm_raw(q: P3) -> P3 {
+    q.map(|c| (c * 1000.0).round() / 1000.0)
+}
+
 /// The drawing of patches: outlines of planar patches, triangles of trimesh patches
-/// (decimated).
-fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
+/// (simplified by [`cluster_triangles`]).
+pub(crate) fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
     let mut polygons = Vec::new();
     let mut triangles = Vec::new();
     for patch in patches {
@@ -88,14 +131,14 @@ fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
     MapDrawing {
         kind: kind.name().to_owned(),
         polygons: decimate(&polygons, MAX_DRAWN),
-        triangles: decimate(&triangles, MAX_DRAWN),
+        triangles: cluster_triangles(&triangles, MAX_DRAWN),
         points: Vec::new(),
     }
 }
 
 /// The patches as one triangle mesh: planar patches triangulated, trimesh patches with their
 /// shared vertices.
-fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+pub(crate) fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     let mut vertices: Vec<Point3> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     for (i, patch) in patches.iter().enumerate() {

@@ -473,8 +473,24 @@ pub fn top_view(drawing: &MapDrawing, overlay: &Overlay<'_>) -> String {
     render(&format!("Top view of the {} map", drawing.kind), &styles, &scene, &over, &marks)
 }
 
+/// A cutaway of `drawing` for the perspective view: without what lies entirely in the top
+/// `band` of `bounds` (the ceiling) or in the `band` next to its minimum-x and minimum-y faces
+/// (the two walls between the camera and the room).
+fn cutaway(drawing: &MapDrawing, bounds: &Bounds3, band: f64) -> MapDrawing {
+    let hidden = |q: &P3| {
+        q[2] > bounds.max[2] - band || q[0] < bounds.min[0] + band || q[1] < bounds.min[1] + band
+    };
+    MapDrawing {
+        kind: drawing.kind.clone(),
+        polygons: drawing.polygons.iter().filter(|p| !p.iter().all(&hidden)).cloned().collect(),
+        triangles: drawing.triangles.iter().filter(|t| !t.iter().all(&hidden)).copied().collect(),
+        points: drawing.points.iter().filter(|q| !hidden(q)).copied().collect(),
+    }
+}
+
 /// Perspective view of `drawing` from a fixed camera above a corner of `bounds`, looking at its
-/// centre; faces shaded by their normal and drawn farthest first (painter's algorithm), the same
+/// centre, cut away so the inside shows (no ceiling, no walls on the camera's side: [`cutaway`]);
+/// faces shaded by their normal and drawn farthest first (painter's algorithm), the same
 /// overlays on top.
 pub fn perspective_view(drawing: &MapDrawing, overlay: &Overlay<'_>, bounds: &Bounds3) -> String {
     let cam = if bounds.is_empty() {
@@ -485,8 +501,14 @@ pub fn perspective_view(drawing: &MapDrawing, overlay: &Overlay<'_>, bounds: &Bo
     } else {
         Perspective::looking_at(bounds)
     };
+    let shown = if bounds.is_empty() {
+        drawing.clone()
+    } else {
+        let e = bounds.extent();
+        cutaway(drawing, bounds, 0.05 * e[0].min(e[1]).min(e[2]).max(0.0) + 0.1)
+    };
     let mut styles = Styles::default();
-    let (scene, over) = primitives(drawing, overlay, &cam, &mut styles);
+    let (scene, over) = primitives(&shown, overlay, &cam, &mut styles);
     let marks = markers(overlay, &cam);
     render(&format!("Perspective view of the {} map", drawing.kind), &styles, &scene, &over, &marks)
 }

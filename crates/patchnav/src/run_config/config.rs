@@ -1,0 +1,582 @@
+//! The configuration file of `patchnav run`: parsed with `deny_unknown_fields`, every value
+//! checked, paths resolved against the file's folder (the keys and their defaults are in the
+//! parent module's documentation).
+
+use crate::extract::SensorPreset;
+use crate::plan::PlannerChoice;
+use crate::scene_map::{MapKind, PatchBackend};
+use crate::terrain::AxesChoice;
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use patch_core::{Point3, Real};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Robot radius when `plan.radius` is not given, metres (the demo's choice).
+pub const DEFAULT_RADIUS: Real = 0.3;
+/// Longest RRT edge when `plan.step` is not given, metres.
+pub const DEFAULT_STEP: Real = 1.0;
+/// Goal tolerance when `plan.goal_tolerance` is not given, metres.
+pub const DEFAULT_GOAL_TOLERANCE: Real = 0.5;
+/// Iteration budget of one planning run when `plan.max_iterations` is not given.
+pub const DEFAULT_MAX_ITERATIONS: u64 = 10_000;
+/// Largest accepted `plan.max_iterations` (a run of this many takes hours).
+pub const MAX_ITERATIONS_LIMIT: u64 = 100_000_000;
+/// Spacing of the points sampled on a mesh's patches for its `pc` map, metres (below half the
+/// default robot radius, the point-cloud map's density assumption).
+pub const DEFAULT_SPACING: Real = 0.05;
+/// Output folder, relative to the configuration file's folder.
+pub const DEFAULT_OUT: &str = "out/run";
+
+/// The file as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConfig {
+    input: RawInput,
+    #[serde(default)]
+    maps: RawMaps,
+    plan: RawPlan,
+    tof: Option<RawTof>,
+    terrain: Option<RawTerrain>,
+    #[serde(default)]
+    output: RawOutput,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInput {
+    name: Option<String>,
+    scans: Option<Vec<PathBuf>>,
+    poses: Option<PathBuf>,
+    mesh: Option<PathBuf>,
+    map: Option<PathBuf>,
+    cloud: Option<PathBuf>,
+    skip_non_finite: Option<bool>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMaps {
+    types: Option<Vec<String>>,
+    backends: Option<Vec<String>>,
+    sensor: Option<String>,
+    spacing: Option<Real>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPlan {
+    start: [Real; 3],
+    goals: Vec<[Real; 3]>,
+    radius: Option<Real>,
+    step: Option<Real>,
+    goal_tolerance: Option<Real>,
+    planners: Option<Vec<String>>,
+    seeds: Option<Vec<u64>>,
+    max_iterations: Option<u64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTof {
+    range: PathBuf,
+    amplitude: PathBuf,
+    meta: PathBuf,
+    confidence: Option<PathBuf>,
+    aat: Option<Real>,
+    unwrap: Option<bool>,
+    low_at: Option<Real>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTerrain {
+    frame: PathBuf,
+    resolution: Option<f64>,
+    sensor_height: Option<f64>,
+    pitch: Option<f64>,
+    axes: Option<String>,
+    max_range: Option<f64>,
+    sectors: Option<usize>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOutput {
+    dir: Option<PathBuf>,
+    write_3d: Option<bool>,
+}
+
+/// What the maps are built from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Input {
+    /// Range scans in their sensor frames, with an optional `poses.json`.
+    Scans {
+        /// The scan files.
+        files: Vec<PathBuf>,
+        /// Poses overriding the scans' own.
+        poses: Option<PathBuf>,
+    },
+    /// A triangle mesh (OBJ): coplanar faces become planar patches.
+    Mesh(PathBuf),
+    /// A map file of any backend.
+    Map(PathBuf),
+    /// A point cloud in the world frame: the `pc` map.
+    Cloud(PathBuf),
+}
+
+/// The planning problem and its planners.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanConfig {
+    /// Start.
+    pub start: Point3,
+    /// Goals, each reached within `goal_tolerance`.
+    pub goals: Vec<Point3>,
+    /// Robot radius, metres.
+    pub radius: Real,
+    /// Longest RRT edge, metres.
+    pub step: Real,
+    /// How close a vertex must come to a goal, metres.
+    pub goal_tolerance: Real,
+    /// Planners, in order.
+    pub planners: Vec<PlannerChoice>,
+    /// Seeds of every planner.
+    pub seeds: Vec<u64>,
+    /// Iteration budget of each run (it stops earlier once every goal is reached).
+    pub max_iterations: u64,
+}
+
+/// The ToF frame to filter (`[tof]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TofConfig {
+    /// 16-bit range PNG.
+    pub range: PathBuf,
+    /// 16-bit amplitude PNG.
+    pub amplitude: PathBuf,
+    /// JSON sidecar.
+    pub meta: PathBuf,
+    /// Optional confidence PNG.
+    pub confidence: Option<PathBuf>,
+    /// AAT override.
+    pub aat: Option<Real>,
+    /// Unwrap flagged pixels instead of dropping them.
+    pub unwrap: bool,
+    /// With `unwrap`: drop flagged pixels with amplitude ≤ this.
+    pub low_at: Option<Real>,
+}
+
+/// The terrain frame to classify (`[terrain]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TerrainConfig {
+    /// The frame.
+    pub frame: PathBuf,
+    /// Hough resolution, degrees.
+    pub resolution: f64,
+    /// Sensor height, metres.
+    pub sensor_height: f64,
+    /// Pitch down, degrees.
+    pub pitch: f64,
+    /// Axes (`None`: by the frame).
+    pub axes: Option<AxesChoice>,
+    /// Horizontal range limit, metres.
+    pub max_range: Option<f64>,
+    /// Azimuth sectors.
+    pub sectors: usize,
+}
+
+/// A checked configuration, paths resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    /// Name of the data set (the report's title).
+    pub name: String,
+    /// The input.
+    pub input: Input,
+    /// Drop non-finite points of unorganised clouds.
+    pub skip_non_finite: bool,
+    /// Map types to build.
+    pub types: Vec<MapKind>,
+    /// Backends each patch map is loaded into (`None`: a map file's own).
+    pub backends: Option<Vec<PatchBackend>>,
+    /// Extraction preset for scans.
+    pub sensor: SensorPreset,
+    /// Sample spacing of a mesh's `pc` map, metres.
+    pub spacing: Real,
+    /// Planning.
+    pub plan: PlanConfig,
+    /// ToF frame.
+    pub tof: Option<TofConfig>,
+    /// Terrain frame.
+    pub terrain: Option<TerrainConfig>,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Write the 3D files.
+    pub write_3d: bool,
+}
+
+/// The map types each input allows, in build order (the default of `maps.types`).
+pub fn allowed_types(input: &Input) -> &'static [MapKind] {
+    match input {
+        Input::Scans { .. } => &MapKind::ALL,
+        Input::Mesh(_) => &[MapKind::Planes, MapKind::Hybrid, MapKind::Pc],
+        // A map file holds one type, known once it is read.
+        Input::Map(_) => &MapKind::ALL,
+        Input::Cloud(_) => &[MapKind::Pc],
+    }
+}
+
+/// One of a value enum's names, or an error naming `key` and the choices.
+fn choice<T: ValueEnum>(key: &str, text: &str) -> Result<T> {
+    T::from_str(text, false).map_err(|_| {
+        let names: Vec<String> = T::value_variants()
+            .iter()
+            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_owned()))
+            .collect();
+        anyhow::anyhow!("{key}: unknown value `{text}`; choose one of: {}", names.join(", "))
+    })
+}
+
+/// Every item of `texts` as a value enum, no repeats, at least one.
+fn choices<T: ValueEnum + PartialEq>(key: &str, texts: &[String]) -> Result<Vec<T>> {
+    if texts.is_empty() {
+        bail!("{key}: give at least one value");
+    }
+    let mut out: Vec<T> = Vec::with_capacity(texts.len());
+    for (i, t) in texts.iter().enumerate() {
+        let v = choice::<T>(&format!("{key}[{i}]"), t)?;
+        if out.contains(&v) {
+            bail!("{key}: `{t}` is listed twice");
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// A positive finite number of metres, or an error naming `key`.
+fn positive(key: &str, v: Real) -> Result<Real> {
+    if !(v.is_finite() && v > 0.0) {
+        bail!("{key} must be a positive number of metres, not {v}");
+    }
+    Ok(v)
+}
+
+/// A finite point.
+fn point(key: &str, p: [Real; 3]) -> Result<Point3> {
+    if !p.iter().all(|c| c.is_finite()) {
+        bail!("{key} must be three finite numbers [x, y, z], not {p:?}");
+    }
+    Ok(Point3::new(p[0], p[1], p[2]))
+}
+
+/// `path` against `base`, checked to be a file.
+fn existing(key: &str, base: &Path, path: &Path) -> Result<PathBuf> {
+    let full = base.join(path);
+    if !full.is_file() {
+        bail!("{key}: no file {}", full.display());
+    }
+    Ok(full)
+}
+
+/// Reads and checks the configuration file `path`.
+///
+/// # Errors
+/// An unreadable file, TOML syntax, an unknown or missing key, a value of the wrong type or
+/// out of range, a missing input file, or keys that contradict each other (two inputs, a map
+/// type the input cannot give); every message is one line naming the key.
+pub fn load(path: &Path) -> Result<Config> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let raw: RawConfig = toml::from_str(&text).map_err(|e| {
+        let line = e.span().map(|s| {
+            text.as_bytes()[..s.start.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
+        });
+        let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+        match line {
+            Some(l) => anyhow::anyhow!("{} line {l}: {message}", path.display()),
+            None => anyhow::anyhow!("{}: {message}", path.display()),
+        }
+    })?;
+    let base = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    let base = if base.as_os_str().is_empty() { PathBuf::from(".") } else { base };
+    resolve(raw, &base, path)
+}
+
+fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
+    let i = raw.input;
+    let given: Vec<&str> = [
+        ("scans", i.scans.is_some()),
+        ("mesh", i.mesh.is_some()),
+        ("map", i.map.is_some()),
+        ("cloud", i.cloud.is_some()),
+    ]
+    .iter()
+    .filter(|(_, g)| *g)
+    .map(|(k, _)| *k)
+    .collect();
+    if given.len() != 1 {
+        bail!(
+            "[input] needs exactly one of `scans`, `mesh`, `map`, `cloud`; {}",
+            if given.is_empty() {
+                "none is given".to_owned()
+            } else {
+                format!(
+                    "got {}",
+                    given.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(" and ")
+                )
+            }
+        );
+    }
+    if i.poses.is_some() && i.scans.is_none() {
+        bail!("input.poses applies to `scans` only");
+    }
+    let input = match (i.scans, i.mesh, i.map, i.cloud) {
+        (Some(scans), ..) => {
+            if scans.is_empty() {
+                bail!("input.scans: give at least one scan");
+            }
+            let files = scans
+                .iter()
+                .enumerate()
+                .map(|(k, s)| existing(&format!("input.scans[{k}]"), base, s))
+                .collect::<Result<Vec<_>>>()?;
+            let poses = i.poses.as_deref().map(|p| existing("input.poses", base, p)).transpose()?;
+            Input::Scans { files, poses }
+        }
+        (_, Some(m), ..) => {
+            let full = existing("input.mesh", base, &m)?;
+            if !full.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+                bail!("input.mesh: {} is not an OBJ mesh (.obj)", full.display());
+            }
+            Input::Mesh(full)
+        }
+        (_, _, Some(m), _) => Input::Map(existing("input.map", base, &m)?),
+        (.., Some(c)) => Input::Cloud(existing("input.cloud", base, &c)?),
+        (None, None, None, None) => bail!("[input] needs one of `scans`, `mesh`, `map`, `cloud`"),
+    };
+    let name = match i.name {
+        Some(n) if n.trim().is_empty() => bail!("input.name must not be empty"),
+        Some(n) => n,
+        None => {
+            path.file_stem().map_or_else(|| "run".to_owned(), |s| s.to_string_lossy().into_owned())
+        }
+    };
+
+    let m = raw.maps;
+    let allowed = allowed_types(&input);
+    let types = match &m.types {
+        Some(t) => {
+            let t: Vec<MapKind> = choices("maps.types", t)?;
+            if let Some(bad) = t.iter().find(|k| !allowed.contains(k)) {
+                let from = match input {
+                    Input::Scans { .. } => "scans",
+                    Input::Mesh(_) => "a mesh",
+                    Input::Map(_) => "a map file",
+                    Input::Cloud(_) => "a point cloud",
+                };
+                let names: Vec<&str> = allowed.iter().map(|k| k.name()).collect();
+                bail!(
+                    "maps.types: a {bad} map cannot be built from {from} (it gives: {})",
+                    names.join(", ")
+                );
+            }
+            t
+        }
+        None => allowed.to_vec(),
+    };
+    let backends =
+        m.backends.as_deref().map(|b| choices::<PatchBackend>("maps.backends", b)).transpose()?;
+    let sensor = match (&m.sensor, &input) {
+        (Some(s), Input::Scans { .. }) => choice("maps.sensor", s)?,
+        (Some(_), _) => bail!("maps.sensor applies to `scans` input only"),
+        (None, _) => SensorPreset::Alrf,
+    };
+    let spacing = match (m.spacing, &input) {
+        (Some(s), Input::Mesh(_)) => positive("maps.spacing", s)?,
+        (Some(_), _) => bail!("maps.spacing applies to `mesh` input only (its pc map)"),
+        (None, _) => DEFAULT_SPACING,
+    };
+
+    let p = raw.plan;
+    if p.goals.is_empty() {
+        bail!("plan.goals: give at least one goal [x, y, z]");
+    }
+    let plan = PlanConfig {
+        start: point("plan.start", p.start)?,
+        goals: p
+            .goals
+            .iter()
+            .enumerate()
+            .map(|(k, g)| point(&format!("plan.goals[{k}]"), *g))
+            .collect::<Result<_>>()?,
+        radius: positive("plan.radius", p.radius.unwrap_or(DEFAULT_RADIUS))?,
+        step: positive("plan.step", p.step.unwrap_or(DEFAULT_STEP))?,
+        goal_tolerance: positive(
+            "plan.goal_tolerance",
+            p.goal_tolerance.unwrap_or(DEFAULT_GOAL_TOLERANCE),
+        )?,
+        planners: match &p.planners {
+            Some(names) => choices("plan.planners", names)?,
+            None => vec![PlannerChoice::Rrt, PlannerChoice::Prm],
+        },
+        seeds: match p.seeds {
+            Some(s) if s.is_empty() => bail!("plan.seeds: give at least one seed"),
+            Some(s) => s,
+            None => vec![1],
+        },
+        max_iterations: match p.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS) {
+            n @ 1..=MAX_ITERATIONS_LIMIT => n,
+            n => bail!("plan.max_iterations must be in 1..={MAX_ITERATIONS_LIMIT}, not {n}"),
+        },
+    };
+
+    let tof = raw
+        .tof
+        .map(|t| -> Result<TofConfig> {
+            if let Some(a) = t.aat
+                && !(a.is_finite() && a > 0.0)
+            {
+                bail!("tof.aat must be a positive threshold, not {a}");
+            }
+            let unwrap = t.unwrap.unwrap_or(true);
+            if let Some(l) = t.low_at {
+                if !unwrap {
+                    bail!("tof.low_at applies only with tof.unwrap = true");
+                }
+                if !(l.is_finite() && l >= 0.0) {
+                    bail!("tof.low_at must be a non-negative amplitude, not {l}");
+                }
+            }
+            Ok(TofConfig {
+                range: existing("tof.range", base, &t.range)?,
+                amplitude: existing("tof.amplitude", base, &t.amplitude)?,
+                meta: existing("tof.meta", base, &t.meta)?,
+                confidence: t
+                    .confidence
+                    .as_deref()
+                    .map(|c| existing("tof.confidence", base, c))
+                    .transpose()?,
+                aat: t.aat,
+                unwrap,
+                low_at: t.low_at,
+            })
+        })
+        .transpose()?;
+
+    let terrain = raw
+        .terrain
+        .map(|t| -> Result<TerrainConfig> {
+            let resolution = t.resolution.unwrap_or(15.0);
+            if !(resolution.is_finite() && resolution > 0.0 && resolution <= 90.0) {
+                bail!("terrain.resolution must be in (0, 90] degrees, not {resolution}");
+            }
+            let sensor_height = t.sensor_height.unwrap_or(0.45);
+            if !(sensor_height.is_finite() && sensor_height.abs() <= 100.0) {
+                bail!(
+                    "terrain.sensor_height must be a finite height in metres, not {sensor_height}"
+                );
+            }
+            let pitch = t.pitch.unwrap_or(0.0);
+            if !(pitch.is_finite() && pitch.abs() < 90.0) {
+                bail!("terrain.pitch must be in (-90, 90) degrees, not {pitch}");
+            }
+            if let Some(r) = t.max_range
+                && !(r.is_finite() && r > 0.0)
+            {
+                bail!("terrain.max_range must be a positive distance in metres, not {r}");
+            }
+            let sectors = t.sectors.unwrap_or(3);
+            if !(1..=90).contains(&sectors) {
+                bail!("terrain.sectors must be in 1..=90, not {sectors}");
+            }
+            Ok(TerrainConfig {
+                frame: existing("terrain.frame", base, &t.frame)?,
+                resolution,
+                sensor_height,
+                pitch,
+                axes: t.axes.as_deref().map(|a| choice("terrain.axes", a)).transpose()?,
+                max_range: t.max_range,
+                sectors,
+            })
+        })
+        .transpose()?;
+
+    let out = base.join(raw.output.dir.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT)));
+    if out.is_file() {
+        bail!("output.dir: {} is a file, not a folder", out.display());
+    }
+    Ok(Config {
+        name,
+        input,
+        skip_non_finite: i.skip_non_finite.unwrap_or(false),
+        types,
+        backends,
+        sensor,
+        spacing,
+        plan,
+        tof,
+        terrain,
+        out,
+        write_3d: raw.output.write_3d.unwrap_or(true),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, text: &str) -> PathBuf {
+        std::fs::write(dir.join("a.ply"), "").unwrap();
+        let p = dir.join("run.toml");
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    const PLAN: &str = "[plan]\nstart = [0, 0, 1]\ngoals = [[1, 0, 1]]\n";
+
+    #[test]
+    fn defaults_fill_every_optional_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let c = load(&write(dir.path(), &format!("[input]\ncloud = \"a.ply\"\n{PLAN}"))).unwrap();
+        assert_eq!(c.input, Input::Cloud(dir.path().join("a.ply")));
+        assert_eq!(c.types, vec![MapKind::Pc]);
+        assert_eq!(c.name, "run");
+        assert_eq!(c.plan.radius, DEFAULT_RADIUS);
+        assert_eq!(c.plan.planners, vec![PlannerChoice::Rrt, PlannerChoice::Prm]);
+        assert_eq!(c.plan.seeds, vec![1]);
+        assert_eq!(c.out, dir.path().join(DEFAULT_OUT));
+        assert!(c.write_3d && c.tof.is_none() && c.terrain.is_none());
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases = [
+            ("[input]\ncloud = \"a.ply\"\nmesh = \"a.ply\"\n", "exactly one of"),
+            ("[input]\ncloud = \"b.ply\"\n", "input.cloud"),
+            ("[input]\ncloud = \"a.ply\"\n[maps]\ntypes = [\"planes\"]\n", "maps.types"),
+            ("[input]\ncloud = \"a.ply\"\n[maps]\nsensor = \"alrf\"\n", "maps.sensor"),
+            ("[input]\nscans = [\"a.ply\"]\n[maps]\nbackends = [\"bullet\"]\n", "maps.backends[0]"),
+            ("[input]\ncloud = \"a.ply\"\nfoo = 1\n", "unknown field `foo`"),
+        ];
+        for (head, needle) in cases {
+            let e = load(&write(dir.path(), &format!("{head}{PLAN}"))).unwrap_err().to_string();
+            assert!(e.contains(needle) && !e.contains('\n'), "{needle}: {e}");
+        }
+        let plans = [
+            ("radius = nan", "plan.radius"),
+            ("step = -1.0", "plan.step"),
+            ("goal_tolerance = 0.0", "plan.goal_tolerance"),
+            ("planners = [\"rrt\", \"rrt\"]", "plan.planners"),
+            ("planners = [\"astar\"]", "plan.planners[0]"),
+            ("seeds = []", "plan.seeds"),
+            ("max_iterations = 0", "plan.max_iterations"),
+        ];
+        for (line, needle) in plans {
+            let text = format!("[input]\ncloud = \"a.ply\"\n{PLAN}{line}\n");
+            let e = load(&write(dir.path(), &text)).unwrap_err().to_string();
+            assert!(e.contains(needle) && !e.contains('\n'), "{needle}: {e}");
+        }
+        let text = "[input]\ncloud = \"a.ply\"\n[plan]\nstart = [0, nan, 1]\ngoals = [[1, 0, 1]]\n";
+        let e = load(&write(dir.path(), text)).unwrap_err().to_string();
+        assert!(e.contains("plan.start"), "{e}");
+    }
+}

@@ -1,0 +1,739 @@
+//! The stages of `patchnav run`: filter the ToF frame and classify the terrain frame if given,
+//! read the input, build the map types in their backends, plan with every planner and seed on
+//! every map, and collect it all in the demo's [`DemoResults`].
+
+use super::config::{Config, Input, TerrainConfig, TofConfig};
+use crate::demo::model::{
+    DemoResults, MapDrawing, MapRow, PlanRun, SceneInfo, TerrainSection, TofSection,
+};
+use crate::demo::pipeline::maps::{drawing, patch_mesh};
+use crate::demo::pipeline::{
+    Clock, Files, MAX_DRAWN, decimate, p3, p3mm, write_mesh_f32, write_ply_f32,
+};
+use crate::extract::SensorPreset;
+use crate::input::InputArgs;
+use crate::plan::{PlannerChoice, make_planner, write_obj_lines};
+use crate::progress::Progress;
+use crate::scene_map::{MapKind, PatchBackend, patch_map, planar_triangles};
+use anyhow::{Context, Result, bail};
+use hough_terrain::{HistogramStyle, hough_png};
+use patch_core::{CapsuleStep, Isometry3, Patch, Point3, UnspecificStepIntersector};
+use patch_extract::{PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes};
+use patch_map::{
+    AnyMap, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh, sample_patch_points,
+};
+use pointcloud::{Aabb, PointCloud, SensorPose};
+use roadmap::metrics::{turn_angles, upper_quartile};
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, PlannerStatus, PlanningSpace, Problem,
+};
+use sensor_tof::PixelOutcome;
+use std::path::Path;
+use std::time::Instant;
+
+/// The backend each patch map is loaded into when `maps.backends` is not given: the parry BVH,
+/// as the demo plans on ([`crate::demo::pipeline::maps::plan_backend`]).
+pub const DEFAULT_BACKEND: PatchBackend = PatchBackend::Trimesh;
+
+/// One map built, in one backend.
+pub struct Built {
+    /// Map type.
+    pub kind: MapKind,
+    /// The map.
+    pub map: AnyMap,
+}
+
+/// What was read.
+enum Source {
+    /// Scans in their sensor frames with their poses.
+    Scans(Vec<PointCloud>),
+    /// A mesh's patches.
+    Patches(Vec<Patch>),
+    /// A map file's map.
+    Map(AnyMap),
+    /// World points.
+    Points(Vec<Point3>),
+}
+
+/// The extraction thresholds of a preset (as `patchnav extract --sensor`).
+fn presets(sensor: SensorPreset) -> (PipelineConfig, TrimeshGrowConfig) {
+    match sensor {
+        SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
+        SensorPreset::RangeCamera => {
+            (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
+        }
+        SensorPreset::Exact => (PipelineConfig::exact(), TrimeshGrowConfig::range_camera()),
+    }
+}
+
+/// The patches of a map type from scans (thesis §6.1): planes by the extraction pipeline, hybrid
+/// with trimesh patches grown on the remainder, trimesh by naive trimesh growing on each scan
+/// (Alg. 4/5) moved into the world frame. For the ALRF preset this is
+/// [`crate::scene_map::extracted_patches`].
+fn scan_patches(clouds: &[PointCloud], kind: MapKind, sensor: SensorPreset) -> Result<Vec<Patch>> {
+    let (pipeline, grow) = presets(sensor);
+    Ok(match kind {
+        MapKind::Planes => extract(clouds, &pipeline, |_| {})?.patches,
+        MapKind::Hybrid => extract(clouds, &pipeline.with_remainder(grow), |_| {})?.patches,
+        MapKind::Trimesh => {
+            let mut patches = Vec::new();
+            for cloud in clouds {
+                let motion =
+                    cloud.sensor_pose().map_or_else(Isometry3::identity, |p| p.world_from_sensor);
+                let grown = grow_trimeshes(cloud, &grow)?;
+                patches.extend(
+                    grown
+                        .into_patches()
+                        .into_iter()
+                        .map(|m| Patch::Trimesh(m.transformed(&motion))),
+                );
+            }
+            patches
+        }
+        MapKind::Pc => bail!("the pc map has no patches"),
+    })
+}
+
+/// The map type a map file holds: `pc` for points, else by its patches.
+fn kind_of(map: &AnyMap) -> MapKind {
+    let Some(patches) = map.patches() else { return MapKind::Pc };
+    let planar = patches.iter().filter(|p| p.as_planar().is_some()).count();
+    match (planar, patches.len() - planar) {
+        (_, 0) => MapKind::Planes,
+        (0, _) => MapKind::Trimesh,
+        _ => MapKind::Hybrid,
+    }
+}
+
+/// Reads the input.
+fn read(config: &Config, progress: &Progress) -> Result<Source> {
+    let options = InputArgs { skip_non_finite: config.skip_non_finite, depth_camera: None };
+    Ok(match &config.input {
+        Input::Scans { files, poses } => {
+            let poses = poses.as_deref().map(crate::extract::read_poses).transpose()?;
+            let bar = progress.bar(files.len() as u64, "reading");
+            let mut clouds = Vec::with_capacity(files.len());
+            for path in files {
+                let mut cloud = crate::input::read_cloud(path, &options)?;
+                if let Some(poses) = &poses {
+                    let name = path.file_name().map(|f| f.to_string_lossy().into_owned());
+                    let pose = name.as_ref().and_then(|n| poses.get(n)).with_context(|| {
+                        format!("input.poses: {} is not in the poses file", path.display())
+                    })?;
+                    cloud.set_sensor_pose(Some(SensorPose { world_from_sensor: *pose }));
+                }
+                if cloud.is_empty() {
+                    bail!("input.scans: {} has no points", path.display());
+                }
+                clouds.push(cloud);
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            Source::Scans(clouds)
+        }
+        Input::Mesh(path) => {
+            let mesh = pointcloud::io::read_mesh(path)?;
+            let (patches, _) = planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
+            if patches.is_empty() {
+                bail!("input.mesh: {} has no usable faces", path.display());
+            }
+            Source::Patches(patches)
+        }
+        Input::Map(path) => Source::Map(crate::map::open_map(path)?),
+        Input::Cloud(path) => {
+            let cloud = crate::input::read_cloud(path, &options)?.to_world();
+            if cloud.is_empty() {
+                bail!("input.cloud: {} has no points", path.display());
+            }
+            Source::Points(cloud.positions().to_vec())
+        }
+    })
+}
+
+/// Maps, rows and drawings, built up.
+struct Maps {
+    built: Vec<Built>,
+    rows: Vec<MapRow>,
+    drawings: Vec<MapDrawing>,
+}
+
+impl Maps {
+    /// Loads `patches` into every backend, records the rows, the drawing and the mesh file.
+    fn add_patches(
+        &mut self,
+        kind: MapKind,
+        patches: Vec<Patch>,
+        seconds: f64,
+        backends: &[PatchBackend],
+        files: &mut Files,
+        write_3d: bool,
+    ) -> Result<()> {
+        if patches.is_empty() {
+            bail!(
+                "the {kind} map has no patches (nothing was extracted); leave it out of maps.types"
+            );
+        }
+        let (mut planar, mut trimesh, mut triangles) = (0, 0, 0);
+        for p in &patches {
+            match p {
+                Patch::Planar(p) => {
+                    planar += 1;
+                    triangles += planar_triangles(p)?.1.len();
+                }
+                Patch::Trimesh(m) => {
+                    trimesh += 1;
+                    triangles += m.num_triangles();
+                }
+            }
+        }
+        for &backend in backends {
+            let t0 = Instant::now();
+            let map = patch_map(patches.clone(), backend)
+                .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
+            let load = t0.elapsed().as_secs_f64();
+            self.rows.push(MapRow {
+                kind: kind.name().to_owned(),
+                backend: backend.name().to_owned(),
+                planar_patches: planar,
+                trimesh_patches: trimesh,
+                triangles,
+                points: 0,
+                memory_bytes: map.memory_bytes(),
+                file_bytes: map.save(std::io::sink())?,
+                build_seconds: seconds + load,
+            });
+            self.built.push(Built { kind, map });
+        }
+        self.drawings.push(drawing(kind, &patches));
+        if write_3d {
+            let name = format!("map-{kind}.ply");
+            let (vertices, faces) = patch_mesh(&patches)?;
+            write_mesh_f32(&files.path(&name), &vertices, &faces)?;
+            files.add(
+                format!("{kind} map: {planar} planar patches (triangulated) and {trimesh} trimesh patches, PLY mesh"),
+                &name,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Records a map used as it is (a map file's, or the pc map).
+    fn add_map(
+        &mut self,
+        kind: MapKind,
+        map: AnyMap,
+        seconds: f64,
+        files: &mut Files,
+        write_3d: bool,
+    ) -> Result<()> {
+        if let Some(patches) = map.patches() {
+            let patches = patches.to_vec();
+            let backend = map.backend().to_owned();
+            let (planar, trimesh) = patches.iter().fold((0, 0), |(a, b), p| match p {
+                Patch::Planar(_) => (a + 1, b),
+                Patch::Trimesh(_) => (a, b + 1),
+            });
+            let mut triangles = 0;
+            for p in &patches {
+                triangles += match p {
+                    Patch::Planar(p) => planar_triangles(p)?.1.len(),
+                    Patch::Trimesh(m) => m.num_triangles(),
+                };
+            }
+            self.rows.push(MapRow {
+                kind: kind.name().to_owned(),
+                backend,
+                planar_patches: planar,
+                trimesh_patches: trimesh,
+                triangles,
+                points: 0,
+                memory_bytes: map.memory_bytes(),
+                file_bytes: map.save(std::io::sink())?,
+                build_seconds: seconds,
+            });
+            self.drawings.push(drawing(kind, &patches));
+            if write_3d {
+                let name = format!("map-{kind}.ply");
+                let (vertices, faces) = patch_mesh(&patches)?;
+                write_mesh_f32(&files.path(&name), &vertices, &faces)?;
+                files.add(format!("{kind} map (PLY mesh)"), &name)?;
+            }
+        } else {
+            let AnyMap::PointCloud(pc) = &map else {
+                bail!("a `{}` map has neither patches nor points", map.backend())
+            };
+            let points: Vec<Point3> = pc.points().collect();
+            if points.is_empty() {
+                bail!("the pc map has no points");
+            }
+            self.rows.push(MapRow {
+                kind: kind.name().to_owned(),
+                backend: map.backend().to_owned(),
+                planar_patches: 0,
+                trimesh_patches: 0,
+                triangles: 0,
+                points: points.len(),
+                memory_bytes: map.memory_bytes(),
+                file_bytes: map.save(std::io::sink())?,
+                build_seconds: seconds,
+            });
+            self.drawings.push(MapDrawing {
+                kind: kind.name().to_owned(),
+                points: decimate(&points, MAX_DRAWN).iter().map(p3mm).collect(),
+                ..MapDrawing::default()
+            });
+            if write_3d {
+                let name = "map-pc.ply";
+                write_ply_f32(&files.path(name), &PointCloud::from_positions(points)?)?;
+                files.add("pc map: its points in the world frame", name)?;
+            }
+        }
+        self.built.push(Built { kind, map });
+        Ok(())
+    }
+}
+
+/// Builds the configured map types from `source`.
+fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files) -> Result<Maps> {
+    let mut maps = Maps { built: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
+    let backends = config.backends.clone().unwrap_or_else(|| vec![DEFAULT_BACKEND]);
+    let bar = progress.bar(config.types.len() as u64, "maps");
+    let w = config.write_3d;
+    let point_map = |points: &[Point3]| -> Result<AnyMap> {
+        Ok(AnyMap::PointCloud(PointCloudMap::from_points(points)?))
+    };
+    match source {
+        Source::Scans(clouds) => {
+            for &kind in &config.types {
+                let t0 = Instant::now();
+                if kind == MapKind::Pc {
+                    let points: Vec<Point3> =
+                        clouds.iter().flat_map(|c| c.to_world().positions().to_vec()).collect();
+                    let map = point_map(&points)?;
+                    maps.add_map(kind, map, t0.elapsed().as_secs_f64(), files, w)?;
+                } else {
+                    let patches = scan_patches(&clouds, kind, config.sensor)
+                        .with_context(|| format!("extracting the {kind} map"))?;
+                    maps.add_patches(
+                        kind,
+                        patches,
+                        t0.elapsed().as_secs_f64(),
+                        &backends,
+                        files,
+                        w,
+                    )?;
+                }
+                bar.inc(1);
+            }
+        }
+        Source::Patches(patches) => {
+            for &kind in &config.types {
+                let t0 = Instant::now();
+                match kind {
+                    MapKind::Planes => {
+                        let planar: Vec<Patch> =
+                            patches.iter().filter(|p| p.as_planar().is_some()).cloned().collect();
+                        maps.add_patches(
+                            kind,
+                            planar,
+                            t0.elapsed().as_secs_f64(),
+                            &backends,
+                            files,
+                            w,
+                        )?;
+                    }
+                    MapKind::Hybrid => {
+                        maps.add_patches(
+                            kind,
+                            patches.clone(),
+                            t0.elapsed().as_secs_f64(),
+                            &backends,
+                            files,
+                            w,
+                        )?;
+                    }
+                    MapKind::Pc => {
+                        let points = sample_patch_points(&patches, config.spacing)?;
+                        let map = point_map(&points)?;
+                        maps.add_map(kind, map, t0.elapsed().as_secs_f64(), files, w)?;
+                    }
+                    MapKind::Trimesh => {
+                        bail!("maps.types: a trimesh map cannot be built from a mesh")
+                    }
+                }
+                bar.inc(1);
+            }
+        }
+        Source::Map(map) => {
+            let kind = kind_of(&map);
+            if !config.types.contains(&kind) {
+                let asked: Vec<&str> = config.types.iter().map(|k| k.name()).collect();
+                bail!("maps.types: the map file holds a {kind} map, not {}", asked.join(", "));
+            }
+            match (&config.backends, map.patches()) {
+                (Some(b), Some(patches)) => {
+                    maps.add_patches(kind, patches.to_vec(), 0.0, b, files, w)?;
+                }
+                (Some(_), None) => bail!("maps.backends: a pc map stays in the pointcloud backend"),
+                (None, _) => maps.add_map(kind, map, 0.0, files, w)?,
+            }
+            bar.inc(1);
+        }
+        Source::Points(points) => {
+            let t0 = Instant::now();
+            let map = point_map(&points)?;
+            maps.add_map(MapKind::Pc, map, t0.elapsed().as_secs_f64(), files, w)?;
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(maps)
+}
+
+/// Whether `planner` runs on `map` (the Evasion and medial-axis planners need patch maps:
+/// thesis Table 5.2).
+pub fn planner_fits(planner: PlannerChoice, map: &AnyMap) -> bool {
+    let needs_patches =
+        matches!(planner, PlannerChoice::EvasionRrt | PlannerChoice::MaPrm | PlannerChoice::MaRrt);
+    !needs_patches || map.patches().is_some()
+}
+
+/// The planning runs and the lines of runs skipped.
+fn plan(
+    config: &Config,
+    maps: &Maps,
+    progress: &Progress,
+    files: &mut Files,
+) -> Result<(Vec<PlanRun>, Vec<String>)> {
+    let p = &config.plan;
+    // The start must be free on every map before any run: the commonest mistake.
+    for m in &maps.built {
+        let bounds = crate::map::map_bounds(&m.map);
+        if !bounds.contains(&p.start) {
+            bail!(
+                "plan.start ({}, {}, {}) is outside the {} map's box ({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
+                p.start.x,
+                p.start.y,
+                p.start.z,
+                m.kind,
+                bounds.min.x,
+                bounds.min.y,
+                bounds.min.z,
+                bounds.max.x,
+                bounds.max.y,
+                bounds.max.z
+            );
+        }
+        let free = CapsuleStep::sphere(p.start, p.radius).is_ok_and(|s| m.map.is_step_free(&s));
+        if !free {
+            bail!(
+                "plan.start ({}, {}, {}) is not free on the {} map: a surface is within plan.radius = {} m",
+                p.start.x,
+                p.start.y,
+                p.start.z,
+                m.kind,
+                p.radius
+            );
+        }
+    }
+    let problem = Problem {
+        start: p.start,
+        goals: p.goals.iter().map(|&center| Goal { center, tolerance: p.goal_tolerance }).collect(),
+    };
+    let runs_per_map = (p.planners.len() * p.seeds.len()) as u64;
+    let bar = progress.bar(maps.built.len() as u64 * runs_per_map, "planning");
+    let mut runs = Vec::new();
+    let mut skipped = Vec::new();
+    let several_backends = |kind: MapKind| maps.built.iter().filter(|b| b.kind == kind).count() > 1;
+    for m in &maps.built {
+        let space = PlanningSpace::new(crate::map::map_bounds(&m.map), p.radius, p.step)
+            .with_context(|| format!("the {} map's planning space", m.kind))?;
+        for &choice in &p.planners {
+            if !planner_fits(choice, &m.map) {
+                skipped.push(format!(
+                    "{} skipped on the {} map: it needs a patch map (proximity queries or specific hits)",
+                    choice.cli_name(),
+                    m.kind
+                ));
+                bar.inc(p.seeds.len() as u64);
+                continue;
+            }
+            for (k, &seed) in p.seeds.iter().enumerate() {
+                let mut run = make_planner(choice, &m.map, space, seed)?;
+                let t0 = Instant::now();
+                let status =
+                    run.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(p.max_iterations)));
+                let seconds = t0.elapsed().as_secs_f64();
+                if status == PlannerStatus::InvalidStart {
+                    bail!("plan.start is not a valid start on the {} map ({})", m.kind, run.name());
+                }
+                let paths: Vec<Vec<Point3>> =
+                    (0..problem.goals.len()).filter_map(|g| run.path_to(g)).collect();
+                let metrics: Vec<PathMetrics> = paths.iter().map(|q| PathMetrics::of(q)).collect();
+                let angles: Vec<f64> = paths.iter().flat_map(|q| turn_angles(q)).collect();
+                let graph = run.roadmap();
+                let edges: Vec<[[f64; 3]; 2]> = graph
+                    .edge_indices()
+                    .filter_map(|e| graph.edge_endpoints(e))
+                    .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
+                    .collect();
+                let name = choice.cli_name();
+                if k == 0 && config.write_3d {
+                    let tag = if several_backends(m.kind) {
+                        format!("{}-{}-{name}", m.kind, m.map.backend())
+                    } else {
+                        format!("{}-{name}", m.kind)
+                    };
+                    let file = format!("roadmap-{tag}.obj");
+                    let points: Vec<Point3> = graph.node_weights().copied().collect();
+                    let lines = graph
+                        .edge_indices()
+                        .filter_map(|e| graph.edge_endpoints(e))
+                        .map(|(a, b)| vec![a.index(), b.index()]);
+                    write_obj_lines(&files.path(&file), &points, lines)?;
+                    files.add(
+                        format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
+                        &file,
+                    )?;
+                    let file = format!("path-{tag}.obj");
+                    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
+                    let mut first = 0;
+                    let lines: Vec<Vec<usize>> = paths
+                        .iter()
+                        .map(|q| {
+                            let line = (first..first + q.len()).collect();
+                            first += q.len();
+                            line
+                        })
+                        .collect();
+                    write_obj_lines(&files.path(&file), &points, lines.into_iter())?;
+                    files.add(
+                        format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
+                        &file,
+                    )?;
+                }
+                let c = run.counters();
+                runs.push(PlanRun {
+                    map: m.kind.name().to_owned(),
+                    backend: m.map.backend().to_owned(),
+                    planner: name,
+                    seed,
+                    solved: paths.len() == problem.goals.len(),
+                    seconds,
+                    iterations: c.samples,
+                    vertices: c.vertices,
+                    collision_checks: c.collision_checks,
+                    path_length: metrics.iter().map(|m| m.length).sum(),
+                    turns: metrics.iter().map(|m| m.turns).sum(),
+                    steep_turns: metrics.iter().map(|m| m.steep_turns).sum(),
+                    curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
+                    start: p3(&p.start),
+                    goals: p.goals.iter().map(p3).collect(),
+                    paths: paths.iter().map(|q| q.iter().map(p3).collect()).collect(),
+                    edges: if k == 0 { decimate(&edges, MAX_DRAWN) } else { Vec::new() },
+                });
+                bar.inc(1);
+            }
+        }
+    }
+    bar.finish_and_clear();
+    Ok((runs, skipped))
+}
+
+/// Filters the ToF frame with the AAT (and unwrapping), as `patchnav tof filter --method aat
+/// [--unwrap]` does, and writes the output cloud (`tof-cloud.ply`). Without the truth of a
+/// simulation, the wrapped, unwrapped-correctly and wrong percentages are unknown (NaN; `null`
+/// in `results.json`, a dash in the report).
+fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
+    let args = crate::tof::FilterArgs {
+        frame: crate::tof::FrameArgs {
+            range: Some(t.range.clone()),
+            amplitude: Some(t.amplitude.clone()),
+            confidence: t.confidence.clone(),
+            meta: t.meta.clone(),
+        },
+        cloud: None,
+        method: crate::tof::Method::Aat,
+        at: 160.0,
+        aat: t.aat,
+        calibration: None,
+        unwrap: t.unwrap,
+        low_at: t.low_at,
+        radial: false,
+        clamp_corners: None,
+        range2: None,
+        amplitude2: None,
+        meta2: None,
+        max_range: 29.5,
+        phase_noise: sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD,
+        min_amplitude: None,
+        out: files.path("tof-cloud.ply"),
+        png: None,
+        dense: false,
+        safe: false,
+    };
+    let t0 = Instant::now();
+    let (frame, out, name) = crate::tof::filter_frame(&args).context("[tof]")?;
+    let millis = t0.elapsed().as_secs_f64() * 1e3;
+    let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
+    let outcomes = out
+        .outcomes
+        .iter()
+        .zip(&measured)
+        .map(|(&o, &m)| match o {
+            PixelOutcome::Kept => 0,
+            PixelOutcome::Unwrapped => 1,
+            PixelOutcome::Dropped if m => 2,
+            PixelOutcome::Dropped => 3,
+        })
+        .collect();
+    if write_3d {
+        let cloud = out.to_cloud(&frame, false);
+        pointcloud::io::write_cloud(&args.out, &cloud)?;
+        files.add(
+            "ToF output cloud (camera frame; field `outcome`: 0 kept, 1 unwrapped)",
+            "tof-cloud.ply",
+        )?;
+    }
+    let camera = frame.camera();
+    Ok(TofSection {
+        scene: t.range.file_name().map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        width: camera.width,
+        height: camera.height,
+        outcomes,
+        radial: out.radial.clone(),
+        method: if t.unwrap { format!("{name} + unwrap") } else { name },
+        discarded_percent: out.counts.discarded_percent(),
+        wrapped_percent: f64::NAN,
+        unwrapped_correct_percent: f64::NAN,
+        wrong_percent: f64::NAN,
+        millis,
+    })
+}
+
+/// Classifies the terrain frame as `patchnav terrain --sectors N` does and writes its Hough
+/// space (`terrain-hough.png`, Fig 4.3 layout).
+fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
+    let args = crate::terrain::TerrainArgs {
+        frame: t.frame.clone(),
+        resolution: t.resolution,
+        sectors: Some(t.sectors),
+        hough_png: None,
+        axes: t.axes,
+        sensor_height: t.sensor_height,
+        pitch: t.pitch,
+        max_range: t.max_range,
+        repeat: 1,
+        json: false,
+        input: InputArgs { skip_non_finite: false, depth_camera: None },
+    };
+    let c = crate::terrain::classify(&args).context("[terrain]")?;
+    let mut png = Vec::new();
+    hough_png(
+        c.classifier.accumulator(),
+        &HistogramStyle::thesis(Some(c.classifier.floor_bin())),
+        &mut png,
+    )?;
+    let name = "terrain-hough.png";
+    std::fs::write(files.path(name), &png).with_context(|| format!("writing {name}"))?;
+    files.add("terrain Hough space (thesis Fig 4.3 layout)", name)?;
+    let class = |x: hough_terrain::TerrainClass| format!("{x:?}").to_lowercase();
+    let plane =
+        c.result.plane.map_or([f64::NAN; 3], |p| [p.rho_x.to_degrees(), p.rho_y.to_degrees(), p.d]);
+    Ok(TerrainSection {
+        scene: t.frame.file_name().map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+        truth: "unknown".to_owned(),
+        class: class(c.result.class),
+        drivable: c.result.drivable,
+        plane,
+        resolution_deg: t.resolution,
+        millis: c.seconds * 1e3,
+        points: c.result.points,
+        hough_png: png,
+        sectors: c
+            .sectors
+            .iter()
+            .map(|s| (class(s.classification.class), s.classification.drivable))
+            .collect(),
+    })
+}
+
+/// Runs every stage, writing the 3D files into `config.out` (which must exist); returns the
+/// results and the lines about runs skipped.
+///
+/// # Errors
+/// An input that cannot be read, a map type that cannot be built from it, a start that is not
+/// free, a planner refusing its map, a ToF or terrain frame that cannot be processed, or a file
+/// that cannot be written.
+pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<String>)> {
+    let out: &Path = &config.out;
+    let mut files = Files::new(out);
+    let mut clock = Clock::new();
+    let tof = match &config.tof {
+        Some(t) => {
+            let section = tof(t, &mut files, config.write_3d)?;
+            clock.lap("ToF: AAT + unwrap");
+            Some(section)
+        }
+        None => None,
+    };
+    let terrain = match &config.terrain {
+        Some(t) => {
+            let section = terrain(t, &mut files)?;
+            clock.lap("terrain: Hough classify");
+            Some(section)
+        }
+        None => None,
+    };
+    let spinner = progress.spinner("reading the input");
+    let source = read(config, progress)?;
+    spinner.finish_and_clear();
+    let (scan_positions, points) = match &source {
+        Source::Scans(clouds) => (
+            clouds
+                .iter()
+                .map(|c| {
+                    c.sensor_pose().map_or([0.0; 3], |p| {
+                        p3(&Point3::from(p.world_from_sensor.translation.vector))
+                    })
+                })
+                .collect(),
+            clouds.iter().map(PointCloud::len).sum(),
+        ),
+        Source::Points(p) => (Vec::new(), p.len()),
+        _ => (Vec::new(), 0),
+    };
+    clock.lap("input: read");
+    let maps = build(config, source, progress, &mut files)?;
+    clock.lap("maps: extract and load");
+    let (plans, skipped) = plan(config, &maps, progress, &mut files)?;
+    clock.lap("planning");
+    let bounds = maps
+        .built
+        .iter()
+        .map(|m| crate::map::map_bounds(&m.map))
+        .fold(Aabb::EMPTY, |a, b| a.union(&b));
+    let scene = SceneInfo {
+        name: config.name.clone(),
+        min: p3(&bounds.min),
+        max: p3(&bounds.max),
+        scan_positions,
+        points,
+    };
+    let results = DemoResults {
+        command: "run".to_owned(),
+        scale: None,
+        seed: config.plan.seeds[0],
+        stages: clock.stages,
+        scene,
+        tof,
+        terrain,
+        maps: maps.rows,
+        drawings: maps.drawings,
+        plans,
+        timing: Vec::new(),
+        volume: None,
+        files: files.entries,
+    };
+    Ok((results, skipped))
+}
