@@ -8,9 +8,8 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, EvasionRrt, EvasionRrtConfig, Goal, GoalReached, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig,
-    MaxIterations, PathMetrics, Planner, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
-    RrtConnect, RrtStar, RrtStarConfig, ShortcutConfig, shortcut_path,
+    AnyOf, Goal, GoalReached, MapCapability, MaxIterations, PathMetrics, Planner, PlannerKind,
+    PlanningSpace, Problem, ShortcutConfig, named_patch_planner, named_planner, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -44,6 +43,21 @@ impl PlannerChoice {
     /// planner reports.
     pub fn cli_name(self) -> String {
         self.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default()
+    }
+
+    /// The planner of the `roadmap` crate.
+    pub fn kind(self) -> PlannerKind {
+        match self {
+            PlannerChoice::Rrt => PlannerKind::Rrt,
+            PlannerChoice::Prm => PlannerKind::Prm,
+            PlannerChoice::PrmStar => PlannerKind::PrmStar,
+            PlannerChoice::LazyPrm => PlannerKind::LazyPrm,
+            PlannerChoice::RrtStar => PlannerKind::RrtStar,
+            PlannerChoice::RrtConnect => PlannerKind::RrtConnect,
+            PlannerChoice::EvasionRrt => PlannerKind::EvasionRrt,
+            PlannerChoice::MaPrm => PlannerKind::MaPrm,
+            PlannerChoice::MaRrt => PlannerKind::MaRrt,
+        }
     }
 }
 
@@ -208,97 +222,37 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// PRM as the thesis configures it (six neighbours), with the direct goal step that every
-/// planner of this command uses.
-fn prm_config() -> PrmConfig {
-    PrmConfig { direct_goal_step: true, ..PrmConfig::thesis() }
-}
-
-/// The planner `choice` on `map`. Every planner tests, after each added vertex, whether the
-/// goal is directly reachable by one free capsule step (the thesis's §6.2.3 variant), so their
-/// results compare.
+/// The planner `choice` on `map` ([`roadmap::named_planner`]). Every planner tests, after each
+/// added vertex, whether the goal is directly reachable by one free capsule step (the thesis's
+/// §6.2.3 variant), so their results compare. The Evasion RRT and the medial-axis planners run
+/// on the concrete backend of `map`: they need specific step hits and proximity queries, which
+/// a point-cloud map cannot give (thesis Table 5.2).
 pub(crate) fn make_planner(
     choice: PlannerChoice,
     map: &AnyMap,
     space: PlanningSpace,
     seed: u64,
 ) -> Result<Box<dyn Planner + '_>> {
-    Ok(match choice {
-        PlannerChoice::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
-        PlannerChoice::Prm => Box::new(Prm::new(map, space, prm_config(), seed)),
-        PlannerChoice::PrmStar => {
-            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
-            Box::new(Prm::new(map, space, config, seed))
-        }
-        PlannerChoice::LazyPrm => Box::new(Prm::lazy(map, space, prm_config(), seed)),
-        PlannerChoice::RrtStar => {
-            let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
-            Box::new(RrtStar::new(map, space, config, seed))
-        }
-        PlannerChoice::RrtConnect => Box::new(RrtConnect::new(map, space, seed)),
-        PlannerChoice::EvasionRrt => evasion_planner(map, space, seed)?,
-        PlannerChoice::MaPrm | PlannerChoice::MaRrt => medial_planner(choice, map, space, seed)?,
-    })
-}
-
-/// A medial-axis planner on the concrete backend of `map` (it needs proximity queries, which a
-/// point-cloud map cannot answer: thesis Table 5.2).
-fn medial_planner(
-    choice: PlannerChoice,
-    map: &AnyMap,
-    space: PlanningSpace,
-    seed: u64,
-) -> Result<Box<dyn Planner + '_>> {
-    fn make<'m, M>(
-        choice: PlannerChoice,
-        m: &'m M,
-        space: PlanningSpace,
-        seed: u64,
-    ) -> Box<dyn Planner + 'm>
-    where
-        M: patch_core::ProximityQuery
-            + patch_core::UnspecificStepIntersector<patch_core::CapsuleStep>,
-    {
-        if choice == PlannerChoice::MaPrm {
-            let config = MaPrmConfig { prm: prm_config(), ..MaPrmConfig::for_space(&space) };
-            Box::new(MaPrm::new(m, space, config, seed))
-        } else {
-            let config =
-                MaRrtConfig { rrt: RrtConfig::lesum(None), ..MaRrtConfig::for_space(&space) };
-            Box::new(MaRrt::new(m, space, config, seed))
-        }
-    }
+    let kind = choice.kind();
+    let Some(needs) = kind.needs() else {
+        return Ok(named_planner(kind, map, space, seed)?);
+    };
     Ok(match map {
-        AnyMap::Polygon(m) => make(choice, m, space, seed),
-        AnyMap::BBox6d(m) => make(choice, m, space, seed),
-        AnyMap::Trimesh(m) => make(choice, m, space, seed),
-        AnyMap::Rapier(m) => make(choice, m, space, seed),
-        other => bail!(
-            "{} needs a map that answers proximity queries; a `{}` map cannot",
-            choice.cli_name(),
-            other.backend()
-        ),
-    })
-}
-
-/// The Evasion RRT on the concrete backend of `map` (it needs specific step hits, which a
-/// point-cloud map cannot give: thesis Table 5.2).
-pub(crate) fn evasion_planner(
-    map: &AnyMap,
-    space: PlanningSpace,
-    seed: u64,
-) -> Result<Box<dyn Planner + '_>> {
-    let config =
-        EvasionRrtConfig { rrt: RrtConfig::lesum(None), ..EvasionRrtConfig::for_space(&space) };
-    Ok(match map {
-        AnyMap::Polygon(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
-        AnyMap::BBox6d(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
-        AnyMap::Trimesh(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
-        AnyMap::Rapier(m) => Box::new(EvasionRrt::new(m, space, config, seed)),
-        other => bail!(
-            "evasion-rrt needs a map that reports which patch a step hits; a `{}` map cannot",
-            other.backend()
-        ),
+        AnyMap::Polygon(m) => named_patch_planner(kind, m, space, seed),
+        AnyMap::BBox6d(m) => named_patch_planner(kind, m, space, seed),
+        AnyMap::Trimesh(m) => named_patch_planner(kind, m, space, seed),
+        AnyMap::Rapier(m) => named_patch_planner(kind, m, space, seed),
+        other => match needs {
+            MapCapability::SpecificHits => bail!(
+                "evasion-rrt needs a map that reports which patch a step hits; a `{}` map cannot",
+                other.backend()
+            ),
+            MapCapability::Proximity => bail!(
+                "{} needs a map that answers proximity queries; a `{}` map cannot",
+                choice.cli_name(),
+                other.backend()
+            ),
+        },
     })
 }
 

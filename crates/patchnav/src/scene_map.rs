@@ -21,16 +21,13 @@
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
-use patch_core::{
-    FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch,
-    Vector3,
-};
+use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Real, TrimeshPatch};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
 use patch_extract::{PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes};
 use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
 use pointcloud::{BeamModel, PointCloud};
-use scene_sim::{Alrf, AlrfConfig, Cuboid, Cylinder, PlanarPolygon, RangeSensor, Scene, Shape};
+use scene_sim::{Alrf, AlrfConfig, RangeSensor, Scene};
 use std::collections::HashMap;
 use std::fmt;
 
@@ -135,10 +132,13 @@ impl Tessellation {
         Ok(())
     }
 
-    /// Segments around a circle of radius `r`.
-    fn segments(&self, r: Real) -> usize {
-        let n = (std::f64::consts::TAU * r / self.curved_edge).ceil();
-        (n.min(100_000.0) as usize).max(self.min_segments)
+    /// The tessellation of curved surfaces (`curved_edge`, `min_segments`) as
+    /// [`scene_sim::patches`] takes it.
+    fn curved(&self) -> scene_sim::patches::Tessellation {
+        scene_sim::patches::Tessellation {
+            curved_edge: self.curved_edge,
+            min_segments: self.min_segments,
+        }
     }
 }
 
@@ -172,28 +172,14 @@ impl SceneSurfaces {
     /// outline's bottom or top edge into notches), or a bad tessellation.
     pub fn of(scene: &Scene, t: &Tessellation) -> Result<SceneSurfaces> {
         t.check()?;
+        let patches = scene_sim::patches::scene_patches(scene, &t.curved())
+            .with_context(|| format!("the surfaces of scene `{}`", scene.name()))?;
         let mut planar = Vec::new();
         let mut curved = Vec::new();
-        for primitive in scene.primitives() {
-            let name = &primitive.name;
-            match &primitive.shape {
-                Shape::Polygon(p) => planar
-                    .push(polygon_patch(p).with_context(|| format!("scene polygon `{name}`"))?),
-                Shape::Cuboid(c) => {
-                    for face in cuboid_faces(c) {
-                        planar.push(face.with_context(|| format!("a face of box `{name}`"))?);
-                    }
-                }
-                Shape::Sphere(s) => curved.push(
-                    sphere_mesh(s.center(), s.radius(), t)
-                        .with_context(|| format!("sphere `{name}`"))?,
-                ),
-                Shape::Cylinder(c) => {
-                    let (side, caps) =
-                        cylinder_surfaces(c, t).with_context(|| format!("cylinder `{name}`"))?;
-                    curved.push(side);
-                    planar.extend(caps);
-                }
+        for patch in patches {
+            match patch {
+                Patch::Planar(p) => planar.push(p),
+                Patch::Trimesh(m) => curved.push(m),
             }
         }
         Ok(SceneSurfaces { planar, curved })
@@ -413,155 +399,6 @@ pub fn extracted_patches(clouds: &[PointCloud], kind: MapKind) -> Result<Option<
     })
 }
 
-/// The patch of a scene polygon. A hole touching the outline (a door reaching the floor) is
-/// invalid for a patch polygon; for an axis-aligned rectangle with rectangular holes, such
-/// holes on the bottom or top edge become notches of the outline.
-fn polygon_patch(p: &PlanarPolygon) -> Result<PlanarPatch> {
-    let holes: Vec<Vec<Point2>> = p.holes().map(<[Point2]>::to_vec).collect();
-    let polygon = match Polygon::new(p.outline().to_vec(), holes.clone()) {
-        Ok(polygon) => polygon,
-        Err(e) => {
-            let Some((outline, holes)) = notched(p.outline(), &holes) else {
-                return Err(e.into());
-            };
-            Polygon::new(outline, holes)?
-        }
-    };
-    Ok(PlanarPatch::new(polygon, *p.world_from_patch())?)
-}
-
-/// The corners `(min, max)` of an axis-aligned rectangle ring, `None` for any other ring.
-fn rectangle(ring: &[Point2]) -> Option<(Point2, Point2)> {
-    if ring.len() != 4 {
-        return None;
-    }
-    let lo = ring.iter().fold(ring[0], |m, p| m.inf(p));
-    let hi = ring.iter().fold(ring[0], |m, p| m.sup(p));
-    let on_corner = |q: &Point2| (q.x == lo.x || q.x == hi.x) && (q.y == lo.y || q.y == hi.y);
-    ring.iter().all(on_corner).then_some((lo, hi))
-}
-
-/// The outline of a rectangle with its bottom- and top-touching rectangular holes cut in as
-/// notches, and the other holes; `None` if the rings are not all axis-aligned rectangles or a
-/// hole touches a side edge.
-fn notched(outline: &[Point2], holes: &[Vec<Point2>]) -> Option<(Vec<Point2>, Vec<Vec<Point2>>)> {
-    let (lo, hi) = rectangle(outline)?;
-    let boxes: Vec<(Point2, Point2)> = holes.iter().map(|h| rectangle(h)).collect::<Option<_>>()?;
-    if boxes.iter().any(|(a, b)| a.x <= lo.x || b.x >= hi.x) {
-        return None;
-    }
-    let mut bottom: Vec<_> = boxes.iter().filter(|(a, _)| a.y <= lo.y).collect();
-    let mut top: Vec<_> = boxes.iter().filter(|(a, b)| a.y > lo.y && b.y >= hi.y).collect();
-    bottom.sort_by(|p, q| p.0.x.total_cmp(&q.0.x));
-    top.sort_by(|p, q| q.0.x.total_cmp(&p.0.x));
-    // Counter-clockwise: along the bottom eastwards, up, along the top westwards.
-    let mut ring = vec![lo];
-    for (a, b) in bottom {
-        let up = b.y.min(hi.y);
-        ring.extend([Point2::new(a.x, lo.y), Point2::new(a.x, up), Point2::new(b.x, up)]);
-        ring.push(Point2::new(b.x, lo.y));
-    }
-    ring.extend([Point2::new(hi.x, lo.y), hi]);
-    for (a, b) in top {
-        ring.extend([Point2::new(b.x, hi.y), Point2::new(b.x, a.y), Point2::new(a.x, a.y)]);
-        ring.push(Point2::new(a.x, hi.y));
-    }
-    ring.push(Point2::new(lo.x, hi.y));
-    ring.dedup();
-    let inner = boxes
-        .iter()
-        .filter(|(a, b)| a.y > lo.y && b.y < hi.y)
-        .map(|(a, b)| vec![*a, Point2::new(b.x, a.y), *b, Point2::new(a.x, b.y)])
-        .collect();
-    Some((ring, inner))
-}
-
-/// A planar patch through world points given counter-clockwise seen from `normal`'s side.
-fn world_patch(mut ring: Vec<Point3>, normal: &Vector3) -> Result<PlanarPatch> {
-    let newell = (0..ring.len()).fold(Vector3::zeros(), |n, i| {
-        let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
-        n + a.coords.cross(&b.coords)
-    });
-    if newell.dot(normal) < 0.0 {
-        ring.reverse();
-    }
-    Ok(PlanarPatch::from_world_polygon(&ring, &[], 1e-9)?)
-}
-
-/// The six faces of a box as planar patches, normals outwards.
-fn cuboid_faces(c: &Cuboid) -> impl Iterator<Item = Result<PlanarPatch>> + '_ {
-    let axes = c.world_from_box().rotation.to_rotation_matrix().into_inner();
-    let h = *c.half_extents();
-    (0..6u32).map(move |part| {
-        let a = (part / 2) as usize;
-        let (i, j) = ((a + 1) % 3, (a + 2) % 3);
-        let u: Vector3 = axes.column(i) * h[i];
-        let v: Vector3 = axes.column(j) * h[j];
-        let centre = c.face_center(part);
-        let ring = vec![centre - u - v, centre + u - v, centre + u + v, centre - u + v];
-        world_patch(ring, &c.face_normal(part))
-    })
-}
-
-/// The side of a cylinder as a mesh and its two caps as regular polygons.
-fn cylinder_surfaces(c: &Cylinder, t: &Tessellation) -> Result<(TrimeshPatch, [PlanarPatch; 2])> {
-    let m: &Isometry3 = c.world_from_cylinder();
-    let (r, h) = (c.radius(), c.half_height());
-    let n = t.segments(r);
-    let rings = ((2.0 * h / t.curved_edge).ceil() as usize).max(1);
-    let at = |k: usize, z: Real| {
-        let a = std::f64::consts::TAU * k as Real / n as Real;
-        m * Point3::new(r * a.cos(), r * a.sin(), z)
-    };
-    let mut vertices = Vec::with_capacity(n * (rings + 1));
-    for j in 0..=rings {
-        let z = -h + 2.0 * h * j as Real / rings as Real;
-        vertices.extend((0..n).map(|k| at(k, z)));
-    }
-    let mut triangles = Vec::with_capacity(2 * n * rings);
-    for j in 0..rings {
-        for k in 0..n {
-            let (a, b) = ((j * n + k) as u32, (j * n + (k + 1) % n) as u32);
-            let (c2, d) = (a + n as u32, b + n as u32);
-            triangles.push([a, b, d]);
-            triangles.push([a, d, c2]);
-        }
-    }
-    let side = TrimeshPatch::new(vertices, triangles)?;
-    let axis = c.axis();
-    let bottom = world_patch((0..n).map(|k| at(k, -h)).collect(), &-axis)?;
-    let top = world_patch((0..n).map(|k| at(k, h)).collect(), &axis)?;
-    Ok((side, [bottom, top]))
-}
-
-/// A sphere as a latitude–longitude mesh.
-fn sphere_mesh(centre: &Point3, r: Real, t: &Tessellation) -> Result<TrimeshPatch> {
-    let n = t.segments(r);
-    let lat = (n / 2).max(2);
-    let mut vertices = vec![centre + Vector3::z() * r, centre - Vector3::z() * r];
-    for j in 1..lat {
-        let polar = std::f64::consts::PI * j as Real / lat as Real;
-        for k in 0..n {
-            let a = std::f64::consts::TAU * k as Real / n as Real;
-            let d = Vector3::new(polar.sin() * a.cos(), polar.sin() * a.sin(), polar.cos());
-            vertices.push(centre + d * r);
-        }
-    }
-    let ring = |j: usize, k: usize| (2 + (j - 1) * n + k % n) as u32;
-    let mut triangles = Vec::new();
-    for k in 0..n {
-        triangles.push([0, ring(1, k), ring(1, k + 1)]);
-        triangles.push([1, ring(lat - 1, k + 1), ring(lat - 1, k)]);
-        for j in 1..lat - 1 {
-            let (a, b) = (ring(j, k), ring(j, k + 1));
-            let (c, d) = (ring(j + 1, k), ring(j + 1, k + 1));
-            triangles.push([a, c, d]);
-            triangles.push([a, d, b]);
-        }
-    }
-    Ok(TrimeshPatch::new(vertices, triangles)?)
-}
-
 /// The constrained Delaunay triangulation of a planar patch, in the world.
 pub(crate) fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     let rings: Vec<Vec<[f64; 2]>> =
@@ -636,7 +473,8 @@ fn chunked(vertices: &[Point3], triangles: &[[u32; 3]], max: usize) -> Result<Ve
 #[cfg(test)]
 mod tests {
     use super::*;
-    use scene_sim::{Material, SceneBuilder, Sphere};
+    use patch_core::Vector3;
+    use scene_sim::{Cuboid, Cylinder, Material, SceneBuilder, Shape, Sphere};
 
     fn one_box() -> Scene {
         let mut b = SceneBuilder::new("one box");
@@ -726,7 +564,7 @@ mod tests {
         else {
             panic!("the south wall is a polygon");
         };
-        let patch = polygon_patch(south).unwrap();
+        let patch = scene_sim::patches::polygon_patch(south).unwrap();
         assert!((patch.area() - (12.0 * 4.0 - 1.2 * 2.1)).abs() < 1e-9);
         assert!((patch.area() - south.area()).abs() < 1e-9);
         assert!(!s.planar.is_empty() && !s.curved.is_empty());

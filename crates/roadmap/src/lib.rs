@@ -141,6 +141,7 @@ mod connect;
 mod evasion;
 mod medial;
 pub mod metrics;
+mod named;
 mod nn;
 mod planner;
 mod prm;
@@ -155,6 +156,9 @@ pub use connect::RrtConnect;
 pub use evasion::{EvasionRrt, EvasionRrtConfig};
 pub use medial::{MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, retract_to_medial_axis};
 pub use metrics::PathMetrics;
+pub use named::{
+    MapCapability, NamedPlannerError, PlannerKind, named_patch_planner, named_planner,
+};
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
 pub use prm::{LazyPrm, Prm, PrmConfig};

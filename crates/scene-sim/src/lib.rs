@@ -38,6 +38,7 @@ mod builders;
 mod bvh;
 mod error;
 mod material;
+pub mod patches;
 mod scene;
 pub mod sensors;
 pub mod shapes;

@@ -1,0 +1,277 @@
+//! Every planner of this crate by name, configured alike for comparisons: each tests, after
+//! every added vertex, whether a goal is directly reachable by one free capsule step (the
+//! thesis's §6.2.3 variant), so their results compare; the RRTs use Lesum's goal bias
+//! ([`RrtConfig::lesum`]) and the PRMs the thesis's six neighbours (Algorithm 14).
+//!
+//! Two planners need more of a map than step tests (thesis Table 5.2): the Evasion RRT needs
+//! specific step hits, the medial-axis planners need proximity queries. [`named_planner`] builds
+//! the others on any map that tests steps; [`named_patch_planner`] builds all nine on a map with
+//! every capability.
+//!
+//! ```
+//! use patch_core::{Aabb, BruteForceMap, Point3};
+//! use roadmap::{PlannerKind, PlanningSpace, named_patch_planner, named_planner};
+//!
+//! let map = BruteForceMap::new();
+//! let space = PlanningSpace::new(Aabb::new(Point3::origin(), Point3::new(4.0, 4.0, 2.0)), 0.2, 0.5)?;
+//! let kind: PlannerKind = "ma-prm".parse()?;
+//! assert!(named_planner(kind, &map, space, 7).is_err(), "needs proximity queries");
+//! let planner = named_patch_planner(kind, &map, space, 7);
+//! # let _ = planner;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use crate::{
+    EvasionRrt, EvasionRrtConfig, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, Planner, PlanningSpace,
+    Prm, PrmConfig, Rrt, RrtConfig, RrtConnect, RrtStar, RrtStarConfig,
+};
+use patch_core::{CapsuleStep, ProximityQuery, SpecificStepIntersector, UnspecificStepIntersector};
+use std::fmt;
+use std::str::FromStr;
+
+/// The planners of this crate.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PlannerKind {
+    /// Rapidly-exploring random tree (thesis Algorithm 13).
+    Rrt,
+    /// Medial-axis RRT (thesis §5.5.2): needs proximity queries.
+    MaRrt,
+    /// Evasion RRT (thesis Algorithm 11): needs specific step hits.
+    EvasionRrt,
+    /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
+    Prm,
+    /// Medial-axis PRM (thesis Algorithm 12): needs proximity queries.
+    MaPrm,
+    /// RRT-Connect (Kuffner and LaValle 2000).
+    RrtConnect,
+    /// PRM* (Karaman and Frazzoli 2011).
+    PrmStar,
+    /// Lazy PRM (Bohlin and Kavraki 2000), six nearest neighbours.
+    LazyPrm,
+    /// RRT* (Karaman and Frazzoli 2011).
+    RrtStar,
+}
+
+/// A capability of a map beyond step tests that some planners need (thesis Table 5.2).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum MapCapability {
+    /// Which patch a step hits ([`SpecificStepIntersector`]).
+    SpecificHits,
+    /// The closest patch to a point ([`ProximityQuery`]).
+    Proximity,
+}
+
+/// Why a planner could not be named or built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NamedPlannerError {
+    /// No planner has this name.
+    #[error("unknown planner `{name}`; known: {}", PlannerKind::ALL.map(PlannerKind::name).join(", "))]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// The planner needs a capability the map lacks; build it with [`named_patch_planner`].
+    #[error("{planner} needs a map with {capability}")]
+    NeedsCapability {
+        /// The planner.
+        planner: PlannerKind,
+        /// What it needs.
+        capability: MapCapability,
+    },
+}
+
+impl PlannerKind {
+    /// All nine: the thesis's five first (Table 5.3's rows), then the others.
+    pub const ALL: [PlannerKind; 9] = [
+        PlannerKind::Rrt,
+        PlannerKind::MaRrt,
+        PlannerKind::EvasionRrt,
+        PlannerKind::Prm,
+        PlannerKind::MaPrm,
+        PlannerKind::RrtConnect,
+        PlannerKind::PrmStar,
+        PlannerKind::LazyPrm,
+        PlannerKind::RrtStar,
+    ];
+
+    /// The lower-case, hyphenated name (`rrt`, `ma-rrt`, `evasion-rrt`, `prm`, `ma-prm`,
+    /// `rrt-connect`, `prm-star`, `lazy-prm`, `rrt-star`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            PlannerKind::Rrt => "rrt",
+            PlannerKind::MaRrt => "ma-rrt",
+            PlannerKind::EvasionRrt => "evasion-rrt",
+            PlannerKind::Prm => "prm",
+            PlannerKind::MaPrm => "ma-prm",
+            PlannerKind::RrtConnect => "rrt-connect",
+            PlannerKind::PrmStar => "prm-star",
+            PlannerKind::LazyPrm => "lazy-prm",
+            PlannerKind::RrtStar => "rrt-star",
+        }
+    }
+
+    /// The capability beyond step tests this planner needs, if any.
+    pub const fn needs(self) -> Option<MapCapability> {
+        match self {
+            PlannerKind::EvasionRrt => Some(MapCapability::SpecificHits),
+            PlannerKind::MaRrt | PlannerKind::MaPrm => Some(MapCapability::Proximity),
+            PlannerKind::Rrt
+            | PlannerKind::Prm
+            | PlannerKind::PrmStar
+            | PlannerKind::LazyPrm
+            | PlannerKind::RrtStar
+            | PlannerKind::RrtConnect => None,
+        }
+    }
+}
+
+impl fmt::Display for MapCapability {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            MapCapability::SpecificHits => "specific step hits",
+            MapCapability::Proximity => "proximity queries",
+        })
+    }
+}
+
+impl fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for PlannerKind {
+    type Err = NamedPlannerError;
+
+    fn from_str(name: &str) -> Result<PlannerKind, NamedPlannerError> {
+        PlannerKind::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| NamedPlannerError::Unknown { name: name.to_owned() })
+    }
+}
+
+/// PRM with the thesis's six neighbours and the direct goal step.
+fn prm_config() -> PrmConfig {
+    PrmConfig { direct_goal_step: true, ..PrmConfig::thesis() }
+}
+
+/// The planner `kind` on any map that tests steps.
+///
+/// # Errors
+/// [`NamedPlannerError::NeedsCapability`] for the Evasion RRT and the medial-axis planners.
+pub fn named_planner<'m, M>(
+    kind: PlannerKind,
+    map: &'m M,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + 'm>, NamedPlannerError>
+where
+    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    step_test_planner(kind, map, space, seed)
+        .map_err(|capability| NamedPlannerError::NeedsCapability { planner: kind, capability })
+}
+
+/// The planner `kind` on a map with every capability (a patch map); the planners that need no
+/// more than step tests are the same as [`named_planner`]'s.
+pub fn named_patch_planner<'m, M>(
+    kind: PlannerKind,
+    map: &'m M,
+    space: PlanningSpace,
+    seed: u64,
+) -> Box<dyn Planner + 'm>
+where
+    M: ProximityQuery + SpecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    match step_test_planner(kind, map, space, seed) {
+        Ok(planner) => planner,
+        Err(MapCapability::SpecificHits) => {
+            let config = EvasionRrtConfig {
+                rrt: RrtConfig::lesum(None),
+                ..EvasionRrtConfig::for_space(&space)
+            };
+            Box::new(EvasionRrt::new(map, space, config, seed))
+        }
+        Err(MapCapability::Proximity) if kind == PlannerKind::MaPrm => {
+            let config = MaPrmConfig { prm: prm_config(), ..MaPrmConfig::for_space(&space) };
+            Box::new(MaPrm::new(map, space, config, seed))
+        }
+        Err(MapCapability::Proximity) => {
+            let config =
+                MaRrtConfig { rrt: RrtConfig::lesum(None), ..MaRrtConfig::for_space(&space) };
+            Box::new(MaRrt::new(map, space, config, seed))
+        }
+    }
+}
+
+/// The planner `kind` if step tests suffice for it, else the capability it needs.
+fn step_test_planner<'m, M>(
+    kind: PlannerKind,
+    map: &'m M,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + 'm>, MapCapability>
+where
+    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    Ok(match kind {
+        PlannerKind::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
+        PlannerKind::Prm => Box::new(Prm::new(map, space, prm_config(), seed)),
+        PlannerKind::PrmStar => {
+            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
+            Box::new(Prm::new(map, space, config, seed))
+        }
+        PlannerKind::LazyPrm => Box::new(Prm::lazy(map, space, prm_config(), seed)),
+        PlannerKind::RrtStar => {
+            let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
+            Box::new(RrtStar::new(map, space, config, seed))
+        }
+        PlannerKind::RrtConnect => Box::new(RrtConnect::new(map, space, seed)),
+        PlannerKind::EvasionRrt => return Err(MapCapability::SpecificHits),
+        PlannerKind::MaRrt | PlannerKind::MaPrm => return Err(MapCapability::Proximity),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{AnyOf, Goal, GoalReached, MaxIterations, PlannerStatus, Problem};
+    use patch_core::{Aabb, BruteForceMap, Point3};
+
+    fn space() -> PlanningSpace {
+        PlanningSpace::new(Aabb::new(Point3::origin(), Point3::new(4.0, 4.0, 2.0)), 0.2, 0.5)
+            .unwrap()
+    }
+
+    #[test]
+    fn names_round_trip_and_unknown_names_are_refused() {
+        for kind in PlannerKind::ALL {
+            assert_eq!(kind.name().parse::<PlannerKind>(), Ok(kind));
+            assert_eq!(kind.to_string(), kind.name());
+        }
+        let e = "rrt-sharp".parse::<PlannerKind>().unwrap_err();
+        assert!(e.to_string().contains("rrt-sharp") && e.to_string().contains("lazy-prm"));
+    }
+
+    #[test]
+    fn needy_planners_are_refused_on_plain_maps_and_all_solve_on_patch_maps() {
+        let map = BruteForceMap::new();
+        let problem = Problem {
+            start: Point3::new(0.5, 0.5, 1.0),
+            goals: vec![Goal { center: Point3::new(3.5, 3.5, 1.0), tolerance: 0.3 }],
+        };
+        for kind in PlannerKind::ALL {
+            match named_planner(kind, &map, space(), 3) {
+                Ok(_) => assert!(kind.needs().is_none(), "{kind}"),
+                Err(NamedPlannerError::NeedsCapability { planner, capability }) => {
+                    assert_eq!((planner, Some(capability)), (kind, kind.needs()));
+                }
+                Err(e) => panic!("{kind}: {e}"),
+            }
+            let mut planner = named_patch_planner(kind, &map, space(), 3);
+            let status = planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(5_000)));
+            assert_eq!(status, PlannerStatus::Exact, "{kind} in free space");
+        }
+    }
+}
