@@ -205,13 +205,7 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
         }
     }
     if let Some(file) = &args.roadmap_out {
-        let graph = planner.roadmap();
-        let points: Vec<Point3> = graph.node_weights().copied().collect();
-        let lines = graph
-            .edge_indices()
-            .filter_map(|e| graph.edge_endpoints(e))
-            .map(|(a, b)| vec![a.index(), b.index()]);
-        write_obj_lines(file, &points, lines)?;
+        write_obj_roadmap(file, planner.roadmap())?;
     }
     if let Some(file) = &args.path_out {
         let path = planner.path_to(0).unwrap_or_default();
@@ -257,6 +251,28 @@ pub(crate) fn make_planner(
 }
 
 /// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).
+/// Writes a roadmap as OBJ: its vertices and one two-point polyline per edge.
+pub(crate) fn write_obj_roadmap(path: &Path, graph: &roadmap::Roadmap) -> Result<()> {
+    let points: Vec<Point3> = graph.node_weights().copied().collect();
+    let lines = graph
+        .edge_indices()
+        .filter_map(|e| graph.edge_endpoints(e))
+        .map(|(a, b)| vec![a.index(), b.index()]);
+    write_obj_lines(path, &points, lines)
+}
+
+/// Writes `paths` as OBJ polylines, one per path.
+pub(crate) fn write_obj_paths(path: &Path, paths: &[Vec<Point3>]) -> Result<()> {
+    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
+    let mut first = 0;
+    let lines = paths.iter().map(move |p| {
+        let line = (first..first + p.len()).collect();
+        first += p.len();
+        line
+    });
+    write_obj_lines(path, &points, lines)
+}
+
 pub(crate) fn write_obj_lines(
     path: &Path,
     points: &[Point3],

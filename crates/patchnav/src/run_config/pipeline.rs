@@ -12,7 +12,7 @@ use crate::demo::pipeline::{
 };
 use crate::extract::SensorPreset;
 use crate::input::InputArgs;
-use crate::plan::{PlannerChoice, make_planner, write_obj_lines};
+use crate::plan::{PlannerChoice, make_planner, write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
 use crate::scene_map::{MapKind, PatchBackend, patch_map, planar_triangles};
 use anyhow::{Context, Result, bail};
@@ -485,28 +485,13 @@ fn plan(
                         format!("{}-{name}", m.kind)
                     };
                     let file = format!("roadmap-{tag}.obj");
-                    let points: Vec<Point3> = graph.node_weights().copied().collect();
-                    let lines = graph
-                        .edge_indices()
-                        .filter_map(|e| graph.edge_endpoints(e))
-                        .map(|(a, b)| vec![a.index(), b.index()]);
-                    write_obj_lines(&files.path(&file), &points, lines)?;
+                    write_obj_roadmap(&files.path(&file), graph)?;
                     files.add(
                         format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
                         &file,
                     )?;
                     let file = format!("path-{tag}.obj");
-                    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
-                    let mut first = 0;
-                    let lines: Vec<Vec<usize>> = paths
-                        .iter()
-                        .map(|q| {
-                            let line = (first..first + q.len()).collect();
-                            first += q.len();
-                            line
-                        })
-                        .collect();
-                    write_obj_lines(&files.path(&file), &points, lines.into_iter())?;
+                    write_obj_paths(&files.path(&file), &paths)?;
                     files.add(
                         format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
                         &file,

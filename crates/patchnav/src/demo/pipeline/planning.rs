@@ -10,7 +10,7 @@ use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
 use crate::experiment::lab::{
     CheckpointTimer, LabMapArgs, checkpoints, common_box, corner_starts, explored,
 };
-use crate::plan::write_obj_lines;
+use crate::plan::{write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
 use crate::scene_map::{BuiltMap, MapKind, MapSource, PatchBackend};
 use anyhow::{Context, Result, bail};
@@ -166,28 +166,13 @@ pub(super) fn plan_all(
                 let name = run.name().to_owned();
                 if s == 0 {
                     let file = format!("roadmap-{}-{name}.obj", m.kind);
-                    let points: Vec<Point3> = graph.node_weights().copied().collect();
-                    let lines = graph
-                        .edge_indices()
-                        .filter_map(|e| graph.edge_endpoints(e))
-                        .map(|(a, b)| vec![a.index(), b.index()]);
-                    write_obj_lines(&files.path(&file), &points, lines)?;
+                    write_obj_roadmap(&files.path(&file), graph)?;
                     files.add(
                         format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
                         &file,
                     )?;
                     let file = format!("path-{}-{name}.obj", m.kind);
-                    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
-                    let mut first = 0;
-                    let lines: Vec<Vec<usize>> = paths
-                        .iter()
-                        .map(|p| {
-                            let line = (first..first + p.len()).collect();
-                            first += p.len();
-                            line
-                        })
-                        .collect();
-                    write_obj_lines(&files.path(&file), &points, lines.into_iter())?;
+                    write_obj_paths(&files.path(&file), &paths)?;
                     files.add(
                         format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
                         &file,
