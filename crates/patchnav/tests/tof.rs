@@ -16,6 +16,14 @@ fn patchnav(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
 }
 
+/// `patchnav tof filter --range R --amplitude A --meta M EXTRA...`.
+fn filter_cmd(range: &str, amplitude: &str, meta: &str, extra: &[&str]) -> Output {
+    let mut args =
+        vec!["tof", "filter", "--range", range, "--amplitude", amplitude, "--meta", meta];
+    args.extend_from_slice(extra);
+    patchnav(&args)
+}
+
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
@@ -108,24 +116,12 @@ fn filter_writes_a_cloud_whose_outcomes_match_the_summary() {
     let (r, a, m) = write_pair(dir.path(), "scene", &frame);
     let out = dir.path().join("out.ply");
     let png = dir.path().join("outcomes.png");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
+    let o = filter_cmd(
         s(&r),
-        "--amplitude",
         s(&a),
-        "--meta",
         s(&m),
-        "--method",
-        "aat",
-        "--unwrap",
-        "--clamp-corners",
-        "--out",
-        s(&out),
-        "--png",
-        s(&png),
-    ]);
+        &["--method", "aat", "--unwrap", "--clamp-corners", "--out", s(&out), "--png", s(&png)],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let [total, measured, kept, unwrapped, dropped, written] = summary(&stdout(&o));
     assert_eq!(total, 176 * 144);
@@ -182,21 +178,12 @@ fn filter_writes_a_cloud_whose_outcomes_match_the_summary() {
     assert_eq!((grey, blue), (kept, unwrapped));
 
     // --safe writes the kept pixels only; the summary still counts every outcome.
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
+    let o = filter_cmd(
         s(&r),
-        "--amplitude",
         s(&a),
-        "--meta",
         s(&m),
-        "--unwrap",
-        "--clamp-corners",
-        "--safe",
-        "--out",
-        s(&out),
-    ]);
+        &["--unwrap", "--clamp-corners", "--safe", "--out", s(&out)],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let [_, _, k2, u2, _, w2] = summary(&stdout(&o));
     assert_eq!((k2, u2, w2), (kept, unwrapped, kept));
@@ -209,22 +196,7 @@ fn plain_at_and_cloud_input_agree_with_the_library() {
     let frame = scene(20e6, RangeKind::Radial);
     let (r, a, m) = write_pair(dir.path(), "scene", &frame);
     let out = dir.path().join("at.ply");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&r),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&m),
-        "--method",
-        "at",
-        "--at",
-        "240",
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&r), s(&a), s(&m), &["--method", "at", "--at", "240", "--out", s(&out)]);
     assert!(o.status.success(), "{}", stderr(&o));
     let [_, _, kept, unwrapped, dropped, _] = summary(&stdout(&o));
     let meta = sensor_tof::io::read_meta(&m).unwrap();
@@ -256,26 +228,23 @@ fn two_frequencies_unwrap_the_far_wall() {
     let (r, a, m) = write_pair(dir.path(), "f20", &scene(20e6, RangeKind::Depth));
     let (r2, a2, m2) = write_pair(dir.path(), "f5", &scene(5e6, RangeKind::Depth));
     let out = dir.path().join("two.ply");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
+    let o = filter_cmd(
         s(&r),
-        "--amplitude",
         s(&a),
-        "--meta",
         s(&m),
-        "--method",
-        "two-freq",
-        "--range2",
-        s(&r2),
-        "--amplitude2",
-        s(&a2),
-        "--meta2",
-        s(&m2),
-        "--out",
-        s(&out),
-    ]);
+        &[
+            "--method",
+            "two-freq",
+            "--range2",
+            s(&r2),
+            "--amplitude2",
+            s(&a2),
+            "--meta2",
+            s(&m2),
+            "--out",
+            s(&out),
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let [total, _, kept, unwrapped, dropped, written] = summary(&stdout(&o));
     assert_eq!((total, dropped, written), (176 * 144, 176, kept + unwrapped));
@@ -287,41 +256,25 @@ fn two_frequencies_unwrap_the_far_wall() {
         assert!((p.coords.norm() - want).abs() < 0.01, "pixel {i}: {}", p.coords.norm());
     }
     // Both frames at one frequency is refused, as is a missing second frame.
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
+    let o = filter_cmd(
         s(&r),
-        "--amplitude",
         s(&a),
-        "--meta",
         s(&m),
-        "--method",
-        "two-freq",
-        "--range2",
-        s(&r),
-        "--amplitude2",
-        s(&a),
-        "--meta2",
-        s(&m),
-        "--out",
-        s(&out),
-    ]);
+        &[
+            "--method",
+            "two-freq",
+            "--range2",
+            s(&r),
+            "--amplitude2",
+            s(&a),
+            "--meta2",
+            s(&m),
+            "--out",
+            s(&out),
+        ],
+    );
     assert_one_line_error(&o, "frequencies");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&r),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&m),
-        "--method",
-        "two-freq",
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&r), s(&a), s(&m), &["--method", "two-freq", "--out", s(&out)]);
     assert_one_line_error(&o, "--range2");
 }
 
@@ -332,83 +285,26 @@ fn bad_inputs_exit_1_with_one_line() {
     let (r, a, m) = write_pair(dir.path(), "scene", &frame);
     let out = dir.path().join("out.ply");
     let missing = dir.path().join("missing.png");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&missing),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&m),
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&missing), s(&a), s(&m), &["--out", s(&out)]);
     assert_one_line_error(&o, "missing.png");
     // A sidecar of another size than the PNGs.
     let mut meta = FrameMeta::for_camera(frame.camera(), RangeKind::Depth, 0.0005);
     meta.width = 170;
     let wrong = dir.path().join("wrong.json");
     write_meta(&wrong, &meta).unwrap();
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&r),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&wrong),
-        "--method",
-        "at",
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&r), s(&a), s(&wrong), &["--method", "at", "--out", s(&out)]);
     assert_one_line_error(&o, "176 × 144, the sidecar says 170 × 144");
     // A truncated PNG, a broken sidecar, an AAT without parameters.
     let cut = dir.path().join("cut.png");
     std::fs::write(&cut, &std::fs::read(&r).unwrap()[..300]).unwrap();
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&cut),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&m),
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&cut), s(&a), s(&m), &["--out", s(&out)]);
     assert_one_line_error(&o, "cut.png");
     std::fs::write(&wrong, "{\"width\": 176,").unwrap();
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&r),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&wrong),
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&r), s(&a), s(&wrong), &["--out", s(&out)]);
     assert_one_line_error(&o, "wrong.json");
     let bare = dir.path().join("bare.json");
     write_meta(&bare, &FrameMeta::for_camera(frame.camera(), RangeKind::Depth, 0.0005)).unwrap();
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&r),
-        "--amplitude",
-        s(&a),
-        "--meta",
-        s(&bare),
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&r), s(&a), s(&bare), &["--out", s(&out)]);
     assert_one_line_error(&o, "no AAT parameters");
     let o = patchnav(&["tof", "calibrate", "--meta", s(&m), "--out", s(&out)]);
     assert_one_line_error(&o, "no frame");
@@ -476,20 +372,7 @@ fn calibrate_recovers_a_known_parabola() {
     // The calibration drives the filter.
     let (sr, sa, _) = write_pair(dir.path(), "scene", &scene(20e6, RangeKind::Depth));
     let out = dir.path().join("out.ply");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
-        s(&sr),
-        "--amplitude",
-        s(&sa),
-        "--meta",
-        s(&m),
-        "--calibration",
-        s(&calib),
-        "--out",
-        s(&out),
-    ]);
+    let o = filter_cmd(s(&sr), s(&sa), s(&m), &["--calibration", s(&calib), "--out", s(&out)]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).starts_with("AAT 0.2:"), "{}", stdout(&o));
 }
@@ -554,21 +437,12 @@ fn simulate_then_filter() {
     let meta = sensor_tof::io::read_meta(&d.join("meta.json")).unwrap();
     let frame = read_png_pair(&d.join("range.png"), &d.join("amplitude.png"), &meta).unwrap();
     let ply = d.join("out.ply");
-    let o = patchnav(&[
-        "tof",
-        "filter",
-        "--range",
+    let o = filter_cmd(
         s(&d.join("range.png")),
-        "--amplitude",
         s(&d.join("amplitude.png")),
-        "--meta",
         s(&d.join("meta.json")),
-        "--method",
-        "aat",
-        "--unwrap",
-        "--out",
-        s(&ply),
-    ]);
+        &["--method", "aat", "--unwrap", "--out", s(&ply)],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let cloud = read_cloud(&ply, &ReadOptions::STRICT).unwrap();
     let Some(FieldData::U8(outcomes)) = cloud.extra_field("outcome").map(|f| &f.data) else {
