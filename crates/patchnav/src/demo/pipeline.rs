@@ -32,7 +32,7 @@
 //!   unsolved, with the paths to the goals they reached.
 
 pub(crate) mod maps;
-mod planning;
+pub(crate) mod planning;
 mod sensors;
 
 use super::model::{DemoResults, FileEntry, Scale, SceneInfo, StageTime};

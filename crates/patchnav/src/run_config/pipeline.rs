@@ -23,10 +23,8 @@ use patch_map::{
     AnyMap, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh, sample_patch_points,
 };
 use pointcloud::{Aabb, PointCloud, SensorPose};
-use roadmap::metrics::{turn_angles, upper_quartile};
-use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, PlannerStatus, PlanningSpace, Problem,
-};
+use roadmap::metrics::upper_quartile;
+use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PlannerStatus, PlanningSpace, Problem};
 use sensor_tof::PixelOutcome;
 use std::path::Path;
 use std::time::Instant;
@@ -173,19 +171,7 @@ impl Maps {
                 "the {kind} map has no patches (nothing was extracted); leave it out of maps.types"
             );
         }
-        let (mut planar, mut trimesh, mut triangles) = (0, 0, 0);
-        for p in &patches {
-            match p {
-                Patch::Planar(p) => {
-                    planar += 1;
-                    triangles += planar_triangles(p)?.1.len();
-                }
-                Patch::Trimesh(m) => {
-                    trimesh += 1;
-                    triangles += m.num_triangles();
-                }
-            }
-        }
+        let (planar, trimesh, triangles) = crate::demo::pipeline::maps::patch_counts(&patches)?;
         for &backend in backends {
             let t0 = Instant::now();
             let map = patch_map(patches.clone(), backend)
@@ -467,16 +453,12 @@ fn plan(
                 if status == PlannerStatus::InvalidStart {
                     bail!("plan.start is not a valid start on the {} map ({})", m.kind, run.name());
                 }
-                let paths: Vec<Vec<Point3>> =
-                    (0..problem.goals.len()).filter_map(|g| run.path_to(g)).collect();
-                let metrics: Vec<PathMetrics> = paths.iter().map(|q| PathMetrics::of(q)).collect();
-                let angles: Vec<f64> = paths.iter().flat_map(|q| turn_angles(q)).collect();
+                let crate::demo::pipeline::planning::RunGeometry { paths, metrics, angles, edges } =
+                    crate::demo::pipeline::planning::RunGeometry::of(
+                        run.as_ref(),
+                        problem.goals.len(),
+                    );
                 let graph = run.roadmap();
-                let edges: Vec<[[f64; 3]; 2]> = graph
-                    .edge_indices()
-                    .filter_map(|e| graph.edge_endpoints(e))
-                    .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
-                    .collect();
                 let name = choice.cli_name();
                 if k == 0 && config.write_3d {
                     let tag = if several_backends(m.kind) {

@@ -70,6 +70,25 @@ pub(crate) struct Built {
     pub(crate) drawings: Vec<MapDrawing>,
 }
 
+/// Planar patches, trimesh patches, and triangles in all (planar patches triangulated), for
+/// Table 6.1.
+pub(crate) fn patch_counts(patches: &[Patch]) -> Result<(usize, usize, usize)> {
+    let (mut planar, mut trimesh, mut triangles) = (0, 0, 0);
+    for p in patches {
+        match p {
+            Patch::Planar(p) => {
+                planar += 1;
+                triangles += planar_triangles(p)?.1.len();
+            }
+            Patch::Trimesh(m) => {
+                trimesh += 1;
+                triangles += m.num_triangles();
+            }
+        }
+    }
+    Ok((planar, trimesh, triangles))
+}
+
 /// Simplifies `triangles` by vertex clustering for the pictures: vertices snapped to the centre
 /// of mass of their cell of a cubic grid, collapsed and repeated triangles dropped, the cell
 /// doubled from 5 cm until at most `budget` remain (then thinned evenly). A coarse but complete
@@ -176,19 +195,7 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
             .context("a patch map has patches")?;
         let extraction = t0.elapsed().as_secs_f64();
         bar.inc(1);
-        let (mut planar, mut trimesh, mut triangles) = (0, 0, 0);
-        for p in &patches {
-            match p {
-                Patch::Planar(p) => {
-                    planar += 1;
-                    triangles += planar_triangles(p)?.1.len();
-                }
-                Patch::Trimesh(m) => {
-                    trimesh += 1;
-                    triangles += m.num_triangles();
-                }
-            }
-        }
+        let (planar, trimesh, triangles) = patch_counts(&patches)?;
         for backend in PATCH_BACKENDS {
             let t1 = Instant::now();
             let map = patch_map(patches.clone(), backend)

@@ -112,6 +112,35 @@ pub(super) fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, V
     Ok((*start, goals))
 }
 
+/// What a finished run found: its paths to the goals it reached, their metrics, all turn
+/// angles, and its roadmap's edges (millimetre-rounded, for the pictures).
+pub(crate) struct RunGeometry {
+    /// One path per reached goal.
+    pub(crate) paths: Vec<Vec<Point3>>,
+    /// The metrics of each path.
+    pub(crate) metrics: Vec<PathMetrics>,
+    /// Every turn angle of every path.
+    pub(crate) angles: Vec<f64>,
+    /// The roadmap's edges.
+    pub(crate) edges: Vec<[[f64; 3]; 2]>,
+}
+
+impl RunGeometry {
+    /// Of `run`, which had `goals` goals.
+    pub(crate) fn of(run: &dyn Planner, goals: usize) -> RunGeometry {
+        let paths: Vec<Vec<Point3>> = (0..goals).filter_map(|g| run.path_to(g)).collect();
+        let metrics = paths.iter().map(|p| PathMetrics::of(p)).collect();
+        let angles = paths.iter().flat_map(|p| turn_angles(p)).collect();
+        let graph = run.roadmap();
+        let edges = graph
+            .edge_indices()
+            .filter_map(|e| graph.edge_endpoints(e))
+            .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
+            .collect();
+        RunGeometry { paths, metrics, angles, edges }
+    }
+}
+
 /// The planning space of `map`: its own box (thesis L6460).
 fn space(map: &BuiltMap) -> Result<PlanningSpace> {
     PlanningSpace::new(crate::map::map_bounds(&map.map), RADIUS, STEP)
@@ -152,16 +181,9 @@ pub(super) fn plan_all(
                 if status == PlannerStatus::InvalidStart {
                     bail!("the start is not free on the {} map", m.kind);
                 }
-                let paths: Vec<Vec<Point3>> =
-                    (0..problem.goals.len()).filter_map(|g| run.path_to(g)).collect();
-                let metrics: Vec<PathMetrics> = paths.iter().map(|p| PathMetrics::of(p)).collect();
-                let angles: Vec<f64> = paths.iter().flat_map(|p| turn_angles(p)).collect();
+                let RunGeometry { paths, metrics, angles, edges } =
+                    RunGeometry::of(run.as_ref(), problem.goals.len());
                 let graph = run.roadmap();
-                let edges: Vec<[[f64; 3]; 2]> = graph
-                    .edge_indices()
-                    .filter_map(|e| graph.edge_endpoints(e))
-                    .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
-                    .collect();
                 let c = run.counters();
                 let name = run.name().to_owned();
                 if s == 0 {
