@@ -142,6 +142,20 @@ fn check_points(points: &[Point3<f64>]) -> Result<()> {
     }
 }
 
+/// The plane normal of the angle pair (`ρx`, `ρy`) of Algorithm 2:
+/// `(−sin ρx cos ρy, −cos ρx sin ρy, cos ρx cos ρy)`, not of unit length (the thesis's), or
+/// normalised for [`NormalKind::Unit`].
+#[inline(always)]
+fn normal(rho_x: f64, rho_y: f64, kind: NormalKind) -> [f64; 3] {
+    let n = [-rho_x.sin() * rho_y.cos(), -rho_x.cos() * rho_y.sin(), rho_x.cos() * rho_y.cos()];
+    if kind == NormalKind::Unit {
+        let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        [n[0] / length, n[1] / length, n[2] / length]
+    } else {
+        n
+    }
+}
+
 /// Algorithm 2 transcribed literally (L3330–3350), the reference the fast voting is tested
 /// against and the baseline of the benchmark: for every point, every sampled `ρx`, every
 /// sampled `ρy`: compute `n` with `sin`/`cos`, `d = n·p`, and increment the bin
@@ -156,15 +170,8 @@ pub fn vote_literal(space: &HoughSpace, points: &[Point3<f64>]) -> Result<Accumu
             let rho_x = space.rho_x(ix);
             for iy in 0..space.ny() {
                 let rho_y = space.rho_y(iy);
-                let mut n = [
-                    -rho_x.sin() * rho_y.cos(),
-                    -rho_x.cos() * rho_y.sin(),
-                    rho_x.cos() * rho_y.cos(),
-                ];
-                if space.normal_kind() == NormalKind::Unit {
-                    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-                    n = [n[0] / length, n[1] / length, n[2] / length];
-                }
+                // Trigonometry per vote, as Algorithm 2 is written.
+                let n = normal(rho_x, rho_y, space.normal_kind());
                 let d = n[0] * p.x + n[1] * p.y + n[2] * p.z;
                 let bin = ((d - d_axis.min) / d_axis.resolution).floor();
                 if bin >= 0.0 && bin < space.nd() as f64 {
@@ -200,16 +207,8 @@ impl NormalTable {
             let rho_y = space.rho_y(iy);
             for ix in 0..space.nx() {
                 let rho_x = space.rho_x(ix);
-                // The same expressions as `vote_literal`, so the same bits.
-                let mut n = [
-                    -rho_x.sin() * rho_y.cos(),
-                    -rho_x.cos() * rho_y.sin(),
-                    rho_x.cos() * rho_y.cos(),
-                ];
-                if space.normal_kind() == NormalKind::Unit {
-                    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-                    n = [n[0] / length, n[1] / length, n[2] / length];
-                }
+                // The same function as `vote_literal`, so the same bits.
+                let n = normal(rho_x, rho_y, space.normal_kind());
                 nx.push(n[0]);
                 ny.push(n[1]);
                 nz.push(n[2]);
