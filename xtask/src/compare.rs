@@ -128,21 +128,8 @@ pub fn run(args: &[String]) -> Result<()> {
             .arg("-DCMAKE_BUILD_TYPE=Release"),
     )?;
     crate::capture(Command::new("cmake").arg("--build").arg(&build).arg("-j2"))?;
-    eprintln!("building patchnav (release)");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    crate::capture(Command::new(cargo).current_dir(&root).args([
-        "build",
-        "--quiet",
-        "--release",
-        "-p",
-        "patchnav",
-    ]))?;
-    let env = Env {
-        patchnav: root.join("target/release/patchnav"),
-        build,
-        out: root.join("target/compare"),
-        bench: args.bench.clone(),
-    };
+    let patchnav = crate::build_patchnav(&root)?;
+    let env = Env { patchnav, build, out: root.join("target/compare"), bench: args.bench.clone() };
     std::fs::create_dir_all(&env.out).with_context(|| format!("creating {}", env.out.display()))?;
     let provenance = crate::provenance::collect(0);
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();

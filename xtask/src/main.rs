@@ -106,6 +106,21 @@ fn project_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
 }
 
+/// Builds `patchnav` in release mode and returns the path of the binary (the peer comparisons
+/// run it as one process per measurement).
+fn build_patchnav(root: &Path) -> Result<PathBuf> {
+    eprintln!("building patchnav (release)");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    capture(std::process::Command::new(cargo).current_dir(root).args([
+        "build",
+        "--quiet",
+        "--release",
+        "-p",
+        "patchnav",
+    ]))?;
+    Ok(root.join("target/release/patchnav"))
+}
+
 /// Runs a command and returns its standard output, failing with its standard error.
 fn capture(cmd: &mut std::process::Command) -> Result<String> {
     let out = cmd.output().with_context(|| format!("could not start {cmd:?}"))?;

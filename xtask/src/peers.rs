@@ -110,16 +110,7 @@ pub fn run(args: &[String]) -> Result<()> {
     let work = args.out.with_extension("d");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
 
-    eprintln!("building patchnav (release)");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    crate::capture(Command::new(cargo).current_dir(&root).args([
-        "build",
-        "--quiet",
-        "--release",
-        "-p",
-        "patchnav",
-    ]))?;
-    let patchnav = root.join("target/release/patchnav");
+    let patchnav = crate::build_patchnav(&root)?;
 
     let build_dir = args.peers_build.clone().unwrap_or_else(|| {
         let own = peers.join("build");

@@ -76,16 +76,7 @@ pub fn run(args: &[String]) -> Result<()> {
     }
     let work = out_path.with_extension("d");
     std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
-    eprintln!("building patchnav (release)");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    crate::capture(Command::new(cargo).current_dir(&root).args([
-        "build",
-        "--quiet",
-        "--release",
-        "-p",
-        "patchnav",
-    ]))?;
-    let patchnav = root.join("target/release/patchnav");
+    let patchnav = crate::build_patchnav(&root)?;
 
     let build_dir = build.unwrap_or_else(|| {
         let own = peers.join("build");

@@ -177,17 +177,13 @@ impl Maps {
             let map = patch_map(patches.clone(), backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
             let load = t0.elapsed().as_secs_f64();
-            self.rows.push(MapRow {
-                kind: kind.name().to_owned(),
-                backend: backend.name().to_owned(),
-                planar_patches: planar,
-                trimesh_patches: trimesh,
-                triangles,
-                points: 0,
-                memory_bytes: map.memory_bytes(),
-                file_bytes: map.save(std::io::sink())?,
-                build_seconds: seconds + load,
-            });
+            self.rows.push(crate::demo::pipeline::maps::patch_map_row(
+                kind,
+                backend,
+                &map,
+                (planar, trimesh, triangles),
+                seconds + load,
+            )?);
             self.built.push(Built { kind, map });
         }
         self.drawings.push(drawing(kind, &patches));

@@ -70,6 +70,28 @@ pub(crate) struct Built {
     pub(crate) drawings: Vec<MapDrawing>,
 }
 
+/// The Table 6.1 row of a patch map of `kind` held by `backend`, with the counts of
+/// [`patch_counts`]; the file size is that of the map file it would save.
+pub(crate) fn patch_map_row(
+    kind: MapKind,
+    backend: PatchBackend,
+    map: &AnyMap,
+    (planar, trimesh, triangles): (usize, usize, usize),
+    build_seconds: f64,
+) -> Result<MapRow> {
+    Ok(MapRow {
+        kind: kind.name().to_owned(),
+        backend: backend.name().to_owned(),
+        planar_patches: planar,
+        trimesh_patches: trimesh,
+        triangles,
+        points: 0,
+        memory_bytes: map.memory_bytes(),
+        file_bytes: map.save(std::io::sink())?,
+        build_seconds,
+    })
+}
+
 /// Planar patches, trimesh patches, and triangles in all (planar patches triangulated), for
 /// Table 6.1.
 pub(crate) fn patch_counts(patches: &[Patch]) -> Result<(usize, usize, usize)> {
@@ -201,18 +223,13 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
             let map = patch_map(patches.clone(), backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
             let load = t1.elapsed().as_secs_f64();
-            let file_bytes = map.save(std::io::sink())?;
-            built.rows.push(MapRow {
-                kind: kind.name().to_owned(),
-                backend: backend.name().to_owned(),
-                planar_patches: planar,
-                trimesh_patches: trimesh,
-                triangles,
-                points: 0,
-                memory_bytes: map.memory_bytes(),
-                file_bytes,
-                build_seconds: extraction + load,
-            });
+            built.rows.push(patch_map_row(
+                kind,
+                backend,
+                &map,
+                (planar, trimesh, triangles),
+                extraction + load,
+            )?);
             if backend == plan_backend(kind) {
                 built.maps.push(BuiltMap {
                     kind,
