@@ -36,13 +36,38 @@ pub struct PrmConfig {
     /// and also connects to neighbours already in its component, so the roadmap has cycles and
     /// paths are shortest by length in it. `false`: Algorithm 14's forest.
     pub star: bool,
+    /// Check each sample's sphere before adding it and drop a colliding one (the iteration
+    /// still counts; one capsule check of zero length). Not in the thesis: Algorithm 14 adds
+    /// every sample, and a colliding one stays an isolated vertex that later samples waste
+    /// neighbour slots on (spec §4). OMPL's PRM samples valid states only.
+    pub valid_samples: bool,
+    /// Try every one of the `N` neighbours, also those already in the sample's component, so
+    /// the roadmap gets cycles and [`Planner::path_to`] returns the shortest path by length
+    /// in it (OMPL's PRM connects this way). `false`: Algorithm 14's forest, whose paths
+    /// follow the first connection found and are longer. Implied by [`star`](Self::star).
+    pub cycles: bool,
 }
 
 impl PrmConfig {
     /// Algorithm 14 as in the thesis: `N = 6` neighbours, no edge-length limit, no direct
     /// goal test.
     pub fn thesis() -> PrmConfig {
-        PrmConfig { neighbours: 6, connection_radius: None, direct_goal_step: false, star: false }
+        PrmConfig {
+            neighbours: 6,
+            connection_radius: None,
+            direct_goal_step: false,
+            star: false,
+            valid_samples: false,
+            cycles: false,
+        }
+    }
+
+    /// Algorithm 14 with the two changes a roadmap for path quality wants (not in the
+    /// thesis): samples checked before they are added ([`valid_samples`](Self::valid_samples))
+    /// and edges to all `N = 6` neighbours ([`cycles`](Self::cycles)), as OMPL's PRM builds
+    /// its roadmap.
+    pub fn valid() -> PrmConfig {
+        PrmConfig { valid_samples: true, cycles: true, ..PrmConfig::thesis() }
     }
 
     /// PRM* (Karaman & Frazzoli 2011, k-nearest variant): [`star`](Self::star) set, no
@@ -419,6 +444,9 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
         let Some(x) = sample(&mut rng) else {
             continue;
         };
+        if config.valid_samples && !checker.free(&x, &x) {
+            continue;
+        }
         let k = config.neighbours_for(solution.graph.node_count() + 1);
         let near = forest.nn.k_nearest(&x, k, max_dist);
         let v = forest.add(solution, x);
@@ -426,7 +454,9 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
             let w = NodeIndex::new(n.index);
             if lazy {
                 forest.connect_lazily(solution, w, v);
-            } else if (config.star || !forest.components.equiv(v.index(), w.index()))
+            } else if (config.star
+                || config.cycles
+                || !forest.components.equiv(v.index(), w.index()))
                 && checker.free(&solution.graph[w], &x)
             {
                 forest.connect(solution, w, v);

@@ -290,7 +290,7 @@ proptest! {
             prop_assert!(graph.node_weights().all(|p| space.bounds().contains(p)));
         }
 
-        let prm_config = PrmConfig { neighbours: 5, connection_radius: radius_limit, direct_goal_step: lesum, star: false };
+        let prm_config = PrmConfig { neighbours: 5, connection_radius: radius_limit, direct_goal_step: lesum, star: false, valid_samples: false, cycles: false };
         let mut prm = Prm::new(&map, space, prm_config, seed);
         let status = prm.solve(&problem, &mut MaxIterations(60));
         assert_all_free(&map, &prm, 1);
