@@ -150,6 +150,7 @@ mod rrt_star;
 pub mod smoothing;
 mod space;
 mod termination;
+pub mod thesis;
 pub mod volume;
 
 pub use connect::RrtConnect;
