@@ -202,6 +202,35 @@ pub trait SpecificStepIntersector<S: Step>: UnspecificStepIntersector<S> + Patch
     fn first_hit(&self, step: &S) -> Option<StepHit>;
 }
 
+/// An action on a map with every capability of a patch map, generic over its backend: what
+/// [`MaybePatchMap::with_patch_map`] runs on the concrete map it holds. A trait, because a
+/// closure cannot be generic over the map type.
+///
+/// Planners that need more than step tests (thesis Table 5.2: the Evasion RRT needs specific
+/// hits, the medial-axis planners proximity queries) are built through it on a map whose
+/// backend is known only at run time.
+pub trait PatchMapVisitor<'m> {
+    /// What the action gives.
+    type Output;
+
+    /// Runs the action on `map`.
+    fn visit<M>(self, map: &'m M) -> Self::Output
+    where
+        M: ProximityQuery + SpecificStepIntersector<crate::CapsuleStep>;
+}
+
+/// A map whose backend is chosen at run time and may or may not be a patch map with every
+/// capability (a point-cloud map is not: it answers neither proximity queries nor specific
+/// hits, thesis Table 5.2).
+pub trait MaybePatchMap {
+    /// Runs `visitor` on the concrete patch map held, or gives it back unrun when this map has
+    /// no patches (`Err(visitor)`).
+    fn with_patch_map<'m, V: PatchMapVisitor<'m>>(&'m self, visitor: V) -> Result<V::Output, V>;
+
+    /// The backend's name, for messages.
+    fn backend_name(&self) -> &'static str;
+}
+
 /// Where a step first touches the map.
 #[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepHit {

@@ -124,8 +124,8 @@ mod step;
 pub mod triangulate;
 
 pub use capability::{
-    FromPatches, PatchId, PatchMap, PatchMapMut, Proximity, ProximityQuery,
-    SpecificStepIntersector, StepHit, Tolerance, UnspecificStepIntersector,
+    FromPatches, MaybePatchMap, PatchId, PatchMap, PatchMapMut, PatchMapVisitor, Proximity,
+    ProximityQuery, SpecificStepIntersector, StepHit, Tolerance, UnspecificStepIntersector,
     is_step_free_via_first_hit,
 };
 pub use counted::{Counted, QueryCounts};

@@ -21,7 +21,8 @@
 use std::io::{Read, Write};
 
 use patch_core::{
-    CapsuleStep, FromPatches, LineStep, Patch, PatchMap, Point3, Real, UnspecificStepIntersector,
+    CapsuleStep, FromPatches, LineStep, MaybePatchMap, Patch, PatchMap, PatchMapVisitor, Point3,
+    Real, UnspecificStepIntersector,
 };
 
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
@@ -255,6 +256,24 @@ impl AnyMap {
             AnyMap::Trimesh(m) => Some(m.patches()),
             AnyMap::Rapier(m) => Some(m.patches()),
         }
+    }
+}
+
+/// The four patch backends run the visitor (every capability of thesis Table 5.2); the
+/// point-cloud map gives it back.
+impl MaybePatchMap for AnyMap {
+    fn with_patch_map<'m, V: PatchMapVisitor<'m>>(&'m self, visitor: V) -> Result<V::Output, V> {
+        match self {
+            AnyMap::Polygon(m) => Ok(visitor.visit(m)),
+            AnyMap::BBox6d(m) => Ok(visitor.visit(m)),
+            AnyMap::Trimesh(m) => Ok(visitor.visit(m)),
+            AnyMap::Rapier(m) => Ok(visitor.visit(m)),
+            AnyMap::PointCloud(_) => Err(visitor),
+        }
+    }
+
+    fn backend_name(&self) -> &'static str {
+        self.backend()
     }
 }
 

@@ -1,4 +1,4 @@
-//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|prm-star|lazy-prm|rrt-star|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
+//! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|prm-valid|prm-star|lazy-prm|rrt-star|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
 //! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
 
@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MapCapability, MaxIterations, PathMetrics, Planner, PlannerKind,
-    PlanningSpace, Problem, ShortcutConfig, named_patch_planner, named_planner, shortcut_path,
+    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlanningSpace,
+    Problem, ShortcutConfig, named_planner_on, shortcut_path,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -36,6 +36,9 @@ pub enum PlannerChoice {
     MaPrm,
     /// Medial-axis RRT (thesis §5.5.2): needs a patch map (proximity queries).
     MaRrt,
+    /// PRM on valid samples with cycles: Algorithm 14 with each sample checked before it is
+    /// added and edges to all six neighbours (as OMPL's PRM); not in the thesis.
+    PrmValid,
 }
 
 impl PlannerChoice {
@@ -57,6 +60,7 @@ impl PlannerChoice {
             PlannerChoice::EvasionRrt => PlannerKind::EvasionRrt,
             PlannerChoice::MaPrm => PlannerKind::MaPrm,
             PlannerChoice::MaRrt => PlannerKind::MaRrt,
+            PlannerChoice::PrmValid => PlannerKind::PrmValid,
         }
     }
 }
@@ -216,38 +220,18 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// The planner `choice` on `map` ([`roadmap::named_planner`]). Every planner tests, after each
-/// added vertex, whether the goal is directly reachable by one free capsule step (the thesis's
-/// §6.2.3 variant), so their results compare. The Evasion RRT and the medial-axis planners run
-/// on the concrete backend of `map`: they need specific step hits and proximity queries, which
-/// a point-cloud map cannot give (thesis Table 5.2).
+/// The planner `choice` on `map` ([`roadmap::named_planner_on`]). Every planner tests, after
+/// each added vertex, whether the goal is directly reachable by one free capsule step (the
+/// thesis's §6.2.3 variant), so their results compare. The Evasion RRT and the medial-axis
+/// planners run on the concrete backend of `map`: they need specific step hits and proximity
+/// queries, which a point-cloud map cannot give (thesis Table 5.2).
 pub(crate) fn make_planner(
     choice: PlannerChoice,
     map: &AnyMap,
     space: PlanningSpace,
     seed: u64,
 ) -> Result<Box<dyn Planner + '_>> {
-    let kind = choice.kind();
-    let Some(needs) = kind.needs() else {
-        return Ok(named_planner(kind, map, space, seed)?);
-    };
-    Ok(match map {
-        AnyMap::Polygon(m) => named_patch_planner(kind, m, space, seed),
-        AnyMap::BBox6d(m) => named_patch_planner(kind, m, space, seed),
-        AnyMap::Trimesh(m) => named_patch_planner(kind, m, space, seed),
-        AnyMap::Rapier(m) => named_patch_planner(kind, m, space, seed),
-        other => match needs {
-            MapCapability::SpecificHits => bail!(
-                "evasion-rrt needs a map that reports which patch a step hits; a `{}` map cannot",
-                other.backend()
-            ),
-            MapCapability::Proximity => bail!(
-                "{} needs a map that answers proximity queries; a `{}` map cannot",
-                choice.cli_name(),
-                other.backend()
-            ),
-        },
-    })
+    Ok(named_planner_on(choice.kind(), map, space, seed)?)
 }
 
 /// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).

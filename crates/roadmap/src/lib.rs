@@ -159,6 +159,7 @@ pub use medial::{MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, retract_to_medial_axis}
 pub use metrics::PathMetrics;
 pub use named::{
     MapCapability, NamedPlannerError, PlannerKind, named_patch_planner, named_planner,
+    named_planner_on,
 };
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};

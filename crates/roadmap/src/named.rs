@@ -5,7 +5,7 @@
 //!
 //! Two planners need more of a map than step tests (thesis Table 5.2): the Evasion RRT needs
 //! specific step hits, the medial-axis planners need proximity queries. [`named_planner`] builds
-//! the others on any map that tests steps; [`named_patch_planner`] builds all nine on a map with
+//! the others on any map that tests steps; [`named_patch_planner`] builds all ten on a map with
 //! every capability.
 //!
 //! ```
@@ -25,7 +25,10 @@ use crate::{
     EvasionRrt, EvasionRrtConfig, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, Planner, PlanningSpace,
     Prm, PrmConfig, Rrt, RrtConfig, RrtConnect, RrtStar, RrtStarConfig,
 };
-use patch_core::{CapsuleStep, ProximityQuery, SpecificStepIntersector, UnspecificStepIntersector};
+use patch_core::{
+    CapsuleStep, MaybePatchMap, PatchMapVisitor, ProximityQuery, SpecificStepIntersector,
+    UnspecificStepIntersector,
+};
 use std::fmt;
 use std::str::FromStr;
 
@@ -50,6 +53,10 @@ pub enum PlannerKind {
     LazyPrm,
     /// RRT* (Karaman and Frazzoli 2011).
     RrtStar,
+    /// PRM on valid samples with cycles ([`PrmConfig::valid`]): Algorithm 14 with each sample
+    /// checked before it is added and edges to all six neighbours, as OMPL's PRM builds its
+    /// roadmap; not in the thesis.
+    PrmValid,
 }
 
 /// A capability of a map beyond step tests that some planners need (thesis Table 5.2).
@@ -78,11 +85,22 @@ pub enum NamedPlannerError {
         /// What it needs.
         capability: MapCapability,
     },
+    /// The planner needs a capability the backend of a run-time map lacks
+    /// ([`named_planner_on`]).
+    #[error("{planner} needs a map with {capability}; a `{backend}` map cannot answer them")]
+    BackendLacks {
+        /// The planner.
+        planner: PlannerKind,
+        /// What it needs.
+        capability: MapCapability,
+        /// The map's backend.
+        backend: &'static str,
+    },
 }
 
 impl PlannerKind {
-    /// All nine: the thesis's five first (Table 5.3's rows), then the others.
-    pub const ALL: [PlannerKind; 9] = [
+    /// All ten: the thesis's five first (Table 5.3's rows), then the others.
+    pub const ALL: [PlannerKind; 10] = [
         PlannerKind::Rrt,
         PlannerKind::MaRrt,
         PlannerKind::EvasionRrt,
@@ -92,10 +110,11 @@ impl PlannerKind {
         PlannerKind::PrmStar,
         PlannerKind::LazyPrm,
         PlannerKind::RrtStar,
+        PlannerKind::PrmValid,
     ];
 
     /// The lower-case, hyphenated name (`rrt`, `ma-rrt`, `evasion-rrt`, `prm`, `ma-prm`,
-    /// `rrt-connect`, `prm-star`, `lazy-prm`, `rrt-star`).
+    /// `rrt-connect`, `prm-star`, `lazy-prm`, `rrt-star`, `prm-valid`).
     pub const fn name(self) -> &'static str {
         match self {
             PlannerKind::Rrt => "rrt",
@@ -107,6 +126,7 @@ impl PlannerKind {
             PlannerKind::PrmStar => "prm-star",
             PlannerKind::LazyPrm => "lazy-prm",
             PlannerKind::RrtStar => "rrt-star",
+            PlannerKind::PrmValid => "prm-valid",
         }
     }
 
@@ -120,6 +140,7 @@ impl PlannerKind {
             | PlannerKind::PrmStar
             | PlannerKind::LazyPrm
             | PlannerKind::RrtStar
+            | PlannerKind::PrmValid
             | PlannerKind::RrtConnect => None,
         }
     }
@@ -205,6 +226,48 @@ where
     }
 }
 
+/// The planner `kind` on a map whose backend is chosen at run time (`patch_map::AnyMap`):
+/// the planners that need only step tests on the map as it is ([`named_planner`]), the others
+/// on the concrete patch map it holds ([`named_patch_planner`]).
+///
+/// # Errors
+/// [`NamedPlannerError::BackendLacks`] when `kind` needs proximity queries or specific hits and
+/// the map holds no patches (a point-cloud map, thesis Table 5.2).
+pub fn named_planner_on<'m, M>(
+    kind: PlannerKind,
+    map: &'m M,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + 'm>, NamedPlannerError>
+where
+    M: MaybePatchMap + UnspecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    let Some(capability) = kind.needs() else {
+        return named_planner(kind, map, space, seed);
+    };
+    map.with_patch_map(PatchPlanner { kind, space, seed }).map_err(|_| {
+        NamedPlannerError::BackendLacks { planner: kind, capability, backend: map.backend_name() }
+    })
+}
+
+/// [`named_patch_planner`] as a [`PatchMapVisitor`].
+struct PatchPlanner {
+    kind: PlannerKind,
+    space: PlanningSpace,
+    seed: u64,
+}
+
+impl<'m> PatchMapVisitor<'m> for PatchPlanner {
+    type Output = Box<dyn Planner + 'm>;
+
+    fn visit<M>(self, map: &'m M) -> Self::Output
+    where
+        M: ProximityQuery + SpecificStepIntersector<CapsuleStep>,
+    {
+        named_patch_planner(self.kind, map, self.space, self.seed)
+    }
+}
+
 /// The planner `kind` if step tests suffice for it, else the capability it needs.
 fn step_test_planner<'m, M>(
     kind: PlannerKind,
@@ -223,6 +286,10 @@ where
             Box::new(Prm::new(map, space, config, seed))
         }
         PlannerKind::LazyPrm => Box::new(Prm::lazy(map, space, prm_config(), seed)),
+        PlannerKind::PrmValid => {
+            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::valid() };
+            Box::new(Prm::new(map, space, config, seed))
+        }
         PlannerKind::RrtStar => {
             let config = RrtStarConfig { rrt: RrtConfig::lesum(None), ..RrtStarConfig::standard() };
             Box::new(RrtStar::new(map, space, config, seed))
@@ -238,6 +305,7 @@ mod tests {
     use super::*;
     use crate::{AnyOf, Goal, GoalReached, MaxIterations, PlannerStatus, Problem};
     use patch_core::{Aabb, BruteForceMap, Point3};
+    use patch_core::{MaybePatchMap, PatchMapVisitor};
 
     fn space() -> PlanningSpace {
         PlanningSpace::new(Aabb::new(Point3::origin(), Point3::new(4.0, 4.0, 2.0)), 0.2, 0.5)
@@ -272,6 +340,60 @@ mod tests {
             let mut planner = named_patch_planner(kind, &map, space(), 3);
             let status = planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(5_000)));
             assert_eq!(status, PlannerStatus::Exact, "{kind} in free space");
+        }
+    }
+
+    /// A run-time map: patches (every capability) or "points" (step tests only).
+    enum RunTimeMap {
+        Patches(BruteForceMap),
+        Points(BruteForceMap),
+    }
+
+    impl UnspecificStepIntersector<CapsuleStep> for RunTimeMap {
+        fn is_step_free(&self, step: &CapsuleStep) -> bool {
+            match self {
+                RunTimeMap::Patches(m) | RunTimeMap::Points(m) => m.is_step_free(step),
+            }
+        }
+    }
+
+    impl MaybePatchMap for RunTimeMap {
+        fn with_patch_map<'m, V: PatchMapVisitor<'m>>(&'m self, v: V) -> Result<V::Output, V> {
+            match self {
+                RunTimeMap::Patches(m) => Ok(v.visit(m)),
+                RunTimeMap::Points(_) => Err(v),
+            }
+        }
+
+        fn backend_name(&self) -> &'static str {
+            match self {
+                RunTimeMap::Patches(_) => "patches",
+                RunTimeMap::Points(_) => "points",
+            }
+        }
+    }
+
+    #[test]
+    fn run_time_maps_build_every_planner_they_can_and_name_the_backend_otherwise() {
+        let patches = RunTimeMap::Patches(BruteForceMap::new());
+        let points = RunTimeMap::Points(BruteForceMap::new());
+        for kind in PlannerKind::ALL {
+            let planner = named_planner_on(kind, &patches, space(), 3).expect("patch map");
+            let expected = if kind == PlannerKind::LazyPrm { "lazy-prm" } else { kind.name() };
+            assert_eq!(planner.name(), expected);
+            match (named_planner_on(kind, &points, space(), 3), kind.needs()) {
+                (Ok(_), None) => {}
+                (
+                    Err(NamedPlannerError::BackendLacks { planner, capability, backend }),
+                    Some(needs),
+                ) => {
+                    assert_eq!((planner, capability, backend), (kind, needs, "points"));
+                    let text =
+                        named_planner_on(kind, &points, space(), 3).err().unwrap().to_string();
+                    assert!(text.contains(kind.name()) && text.contains("`points`"), "{text}");
+                }
+                (other, needs) => panic!("{kind}: {:?} with needs {needs:?}", other.err()),
+            }
         }
     }
 }

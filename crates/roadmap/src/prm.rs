@@ -155,11 +155,12 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> {
     fn name(&self) -> &'static str {
-        match (self.lazy, self.config.star) {
-            (false, false) => "prm",
-            (false, true) => "prm-star",
-            (true, false) => "lazy-prm",
-            (true, true) => "lazy-prm-star",
+        match (self.lazy, self.config.star, self.config.valid_samples || self.config.cycles) {
+            (false, false, false) => "prm",
+            (false, false, true) => "prm-valid",
+            (false, true, _) => "prm-star",
+            (true, false, _) => "lazy-prm",
+            (true, true, _) => "lazy-prm-star",
         }
     }
 

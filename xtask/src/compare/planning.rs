@@ -25,8 +25,20 @@ const SOLVE_ITERATIONS: u64 = 20_000;
 const TIME_LIMIT_S: f64 = 30.0;
 /// Our backends: two patch maps and the same triangles.
 const OUR_BACKENDS: [&str; 3] = ["polygon", "bbox6d", "trimesh"];
-/// (our planner name, OMPL program's planner name).
-const PLANNERS: [(&str, &str); 3] = [("rrt", "rrt"), ("rrt-connect", "rrtconnect"), ("prm", "prm")];
+/// (common planner name, OMPL program's planner name, our planners run against it). The
+/// first of ours has the common name; a variant's side is labelled `ours/{backend} {variant}`.
+/// PRM runs twice on our side: the thesis's Algorithm 14 (`prm`: unchecked samples, a forest)
+/// and `prm-valid` (samples checked, edges to all six neighbours: the roadmap OMPL's PRM builds).
+const PLANNERS: [(&str, &str, &[&str]); 3] = [
+    ("rrt", "rrt", &["rrt"]),
+    ("rrt-connect", "rrtconnect", &["rrt-connect"]),
+    ("prm", "prm", &["prm", "prm-valid"]),
+];
+
+/// The side label of our planner `variant` of the common planner `common` on `backend`.
+fn our_side(backend: &str, common: &str, variant: &str) -> String {
+    if variant == common { format!("ours/{backend}") } else { format!("ours/{backend} {variant}") }
+}
 const MODES: [&str; 3] = ["explore", "solve", "roi"];
 /// OMPL as shipped (RRT goal bias 0.05, goal reached within the tolerance).
 const STOCK: &str = "ompl+fcl";
@@ -112,7 +124,7 @@ pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
     for name in ["floorplan", "lab"] {
         for mode in MODES {
             let problem = write_problem(env, name, mode, seeds)?;
-            for (ours, theirs) in PLANNERS {
+            for (ours, theirs, variants) in PLANNERS {
                 if mode == "explore" && ours == "rrt-connect" {
                     continue; // two trees and a goal: no explore mode
                 }
@@ -132,22 +144,24 @@ pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
                     a.push("--direct-goal".into());
                     rows.extend(tagged(json_lines(&omplx, &a), DIRECT, name, mode, ours));
                 }
-                for backend in OUR_BACKENDS {
-                    let a = [
-                        "--quiet",
-                        "plan",
-                        "--problem",
-                        &arg(&problem),
-                        "--backend",
-                        backend,
-                        "--planner",
-                        ours,
-                        "--mode",
-                        mode,
-                    ]
-                    .map(str::to_owned);
-                    let side = format!("ours/{backend}");
-                    rows.extend(tagged(json_lines(&env.patchnav, &a), &side, name, mode, ours));
+                for variant in variants {
+                    for backend in OUR_BACKENDS {
+                        let a = [
+                            "--quiet",
+                            "plan",
+                            "--problem",
+                            &arg(&problem),
+                            "--backend",
+                            backend,
+                            "--planner",
+                            variant,
+                            "--mode",
+                            mode,
+                        ]
+                        .map(str::to_owned);
+                        let side = our_side(backend, ours, variant);
+                        rows.extend(tagged(json_lines(&env.patchnav, &a), &side, name, mode, ours));
+                    }
                 }
             }
         }
@@ -214,7 +228,7 @@ fn table(rows: &[Value]) -> String {
     );
     for problem in ["floorplan", "lab"] {
         for mode in MODES {
-            for (planner, _) in PLANNERS {
+            for (planner, _, variants) in PLANNERS {
                 let group = |side: &str| -> Vec<&Value> {
                     rows.iter()
                         .filter(|r| {
@@ -232,11 +246,14 @@ fn table(rows: &[Value]) -> String {
                 let direct = stats(&group(DIRECT));
                 let reference = if direct.runs > 0 { DIRECT } else { STOCK };
                 let theirs = if direct.runs > 0 { direct } else { stock };
-                let sides = [STOCK, DIRECT]
-                    .into_iter()
-                    .filter(|s| *s == STOCK || reference == DIRECT)
-                    .map(str::to_owned)
-                    .chain(OUR_BACKENDS.iter().map(|b| format!("ours/{b}")));
+                let sides =
+                    [STOCK, DIRECT]
+                        .into_iter()
+                        .filter(|s| *s == STOCK || reference == DIRECT)
+                        .map(str::to_owned)
+                        .chain(variants.iter().flat_map(|v| {
+                            OUR_BACKENDS.iter().map(move |b| our_side(b, planner, v))
+                        }));
                 for side in sides {
                     let s = stats(&group(&side));
                     let is_theirs = side.starts_with("ompl");
@@ -290,5 +307,22 @@ mod tests {
         assert!((s.us_per_check.unwrap() - 1e5).abs() < 1e-6);
         assert_eq!(s.time_s, Some(2.0));
         assert_eq!(s.path_length, Some(3.0));
+    }
+
+    #[test]
+    fn variants_get_their_own_side_and_the_common_planner_keeps_the_plain_label() {
+        assert_eq!(our_side("trimesh", "prm", "prm"), "ours/trimesh");
+        assert_eq!(our_side("trimesh", "prm", "prm-valid"), "ours/trimesh prm-valid");
+        let rows: Vec<Value> = ["ompl+fcl", "ours/polygon", "ours/polygon prm-valid"]
+            .iter()
+            .map(|side| {
+                json!({"problem": "floorplan", "mode": "solve", "planner_common": "prm",
+                       "side": side, "time_s": 0.002, "iterations": 10.0, "solved": true,
+                       "path_length": 4.0})
+            })
+            .collect();
+        let t = table(&rows);
+        assert!(t.contains("| ours/polygon prm-valid | 1 | 1/1 |"), "{t}");
+        assert!(t.contains("| ours/polygon | 1 | 1/1 |"), "{t}");
     }
 }
