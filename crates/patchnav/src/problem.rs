@@ -11,18 +11,14 @@
 
 use crate::plan::{PlannerChoice, make_planner};
 use crate::progress::Progress;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use patch_core::{FromPatches, Patch, Point3, Real};
 use patch_map::{
     AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
     planar_patches_from_mesh, sample_patch_points,
 };
-use pointcloud::Aabb;
-use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, PlanningSpace,
-    Problem,
-};
+use roadmap::{AnyOf, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, Problem};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -72,103 +68,11 @@ pub struct ProblemArgs {
     pub sample_spacing: Option<Real>,
 }
 
-/// A planning problem read from its JSON file (the shared exchange format).
-pub(crate) struct ProblemFile {
-    pub(crate) name: String,
-    pub(crate) mesh: PathBuf,
-    pub(crate) robot_radius: Real,
-    pub(crate) max_step: Real,
-    pub(crate) bounds: Aabb,
-    pub(crate) start: Point3,
-    pub(crate) goals: Vec<Point3>,
-    pub(crate) goal_tolerance: Real,
-    pub(crate) iterations: u64,
-    pub(crate) seeds: Vec<u64>,
-}
+pub(crate) use roadmap::ProblemFile;
 
-impl ProblemFile {
-    /// The planning space of the problem (its bounds, robot radius and step).
-    pub(crate) fn space(&self) -> Result<PlanningSpace> {
-        PlanningSpace::new(self.bounds, self.robot_radius, self.max_step)
-            .context("bounds, robot_radius, max_step")
-    }
-
-    /// The query from the start to `goals` (each a ball of the problem's tolerance).
-    pub(crate) fn query(&self, goals: &[Point3]) -> Problem {
-        Problem {
-            start: self.start,
-            goals: goals
-                .iter()
-                .map(|&center| Goal { center, tolerance: self.goal_tolerance })
-                .collect(),
-        }
-    }
-}
-
-fn point(v: &Value, what: &str) -> Result<Point3> {
-    let a: Vec<Real> = v
-        .as_array()
-        .with_context(|| format!("`{what}` is not an array"))?
-        .iter()
-        .map(|x| x.as_f64().with_context(|| format!("`{what}` holds a non-number")))
-        .collect::<Result<_>>()?;
-    match a[..] {
-        [x, y, z] if a.iter().all(|c| c.is_finite()) => Ok(Point3::new(x, y, z)),
-        _ => bail!("`{what}` is not three finite numbers"),
-    }
-}
-
-fn number(v: &Value, key: &str) -> Result<Real> {
-    v.get(key)
-        .and_then(Value::as_f64)
-        .with_context(|| format!("`{key}` is missing or not a number"))
-}
-
-/// Reads a problem JSON; the mesh path is resolved relative to the file.
+/// Reads a problem JSON ([`ProblemFile::read`]); the mesh path is resolved relative to the file.
 pub(crate) fn read_problem(path: &Path) -> Result<ProblemFile> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
-    let mesh = v.get("mesh").and_then(Value::as_str).context("`mesh` is missing")?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let bounds = v.get("bounds").context("`bounds` is missing")?;
-    let goals = v
-        .get("goals")
-        .and_then(Value::as_array)
-        .context("`goals` is missing")?
-        .iter()
-        .enumerate()
-        .map(|(i, g)| point(g, &format!("goals[{i}]")))
-        .collect::<Result<_>>()?;
-    let seeds = match v.get("seeds") {
-        None => vec![0],
-        Some(s) => s
-            .as_array()
-            .context("`seeds` is not an array")?
-            .iter()
-            .map(|x| x.as_u64().context("`seeds` holds a value that is not a non-negative integer"))
-            .collect::<Result<_>>()?,
-    };
-    let iterations = number(&v, "iterations")?;
-    if !(iterations >= 0.0 && iterations.fract() == 0.0 && iterations <= 1e9) {
-        bail!("`iterations` must be a whole number up to 10⁹, got {iterations}");
-    }
-    Ok(ProblemFile {
-        name: v.get("name").and_then(Value::as_str).unwrap_or("problem").to_owned(),
-        mesh: dir.join(mesh),
-        robot_radius: number(&v, "robot_radius")?,
-        max_step: number(&v, "max_step")?,
-        bounds: Aabb::new(
-            point(bounds.get("min").context("`bounds.min` is missing")?, "bounds.min")?,
-            point(bounds.get("max").context("`bounds.max` is missing")?, "bounds.max")?,
-        ),
-        start: point(v.get("start").context("`start` is missing")?, "start")?,
-        goals,
-        goal_tolerance: number(&v, "goal_tolerance")?,
-        iterations: iterations as u64,
-        seeds,
-    })
+    ProblemFile::read(path).with_context(|| format!("problem file {}", path.display()))
 }
 
 /// The problem's mesh as planar patches (exact CAD faces).

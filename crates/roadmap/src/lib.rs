@@ -145,6 +145,7 @@ mod named;
 mod nn;
 mod planner;
 mod prm;
+mod problem_file;
 mod rrt;
 mod rrt_star;
 pub mod smoothing;
@@ -164,6 +165,7 @@ pub use named::{
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
 pub use prm::{LazyPrm, Prm, PrmConfig};
+pub use problem_file::{MAX_ITERATIONS, ProblemFile, ProblemFileError};
 pub use rrt::{Rrt, RrtConfig, Sampler};
 pub use rrt_star::{RrtStar, RrtStarConfig};
 pub use smoothing::{ShortcutConfig, shortcut_path};
