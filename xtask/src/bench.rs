@@ -6,6 +6,20 @@
 //! file for the same git revision (a case key holds the scene, backend, planner and seed). After
 //! a run of the matrix its rows of this revision are also written as OMPL benchmark logs, one per
 //! scene and backend, under `target/bench/ompl/` (see [`crate::ompl_log`]).
+//!
+//! # The lab's maps from scans
+//! The matrix's `lab-scans-*` scenes (thesis Fig 6.4 as the thesis ran it) plan on the lab's
+//! four map types built from simulated ALRF scans. The scan → extraction pipeline lives in
+//! `patchnav`, so when the selection runs any of those scenes (no `--scene`, `--scene
+//! lab-scans`, or a `lab-scans-*` name) this command builds the release `patchnav` and, once,
+//! the four map files with `patchnav map build --scene lab --kind K --source scans` (patch
+//! maps in the polygon backend, the pc map as a point-cloud map) into
+//! `target/bench/lab-maps/<key>/`, the key naming every build parameter ([`LabMapParams`]).
+//! The folder is reused while its `build.json` (written last, after all four maps) is newer
+//! than the `patchnav` binary, so a changed pipeline rebuilds it. `bench-matrix` gets the
+//! folder in `$PATCHNAV_LAB_MAPS`. `--lab-scans N` (default 8, `patchnav experiment
+//! lab-timing`'s default; the thesis's Lab has 29) and `--lab-scan-step-deg D` (default: the
+//! S300's 0.5°) choose the scans.
 
 use anyhow::{Context, Result, bail};
 use serde_json::Value;
@@ -22,6 +36,86 @@ struct Args {
     /// Options passed through to the matrix benchmarks (`--scene`, `--backend`, ...).
     matrix: Vec<String>,
     resume: bool,
+    /// How the lab's maps from scans are built.
+    lab: LabMapParams,
+}
+
+/// The build parameters of the lab's maps from scans: the cache key, and the options of
+/// `patchnav map build`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabMapParams {
+    /// Seed of the lab scene, the scan poses and the sensor noise (the matrix's exact lab uses
+    /// seed 0).
+    pub scene_seed: u64,
+    /// Simulated ALRF scans.
+    pub scans: u64,
+    /// Scanner height above the floor, metres.
+    pub scan_height: f64,
+    /// Angular step of the ALRF in degrees; `None`: the S300's 0.5°.
+    pub scan_step_deg: Option<f64>,
+}
+
+/// The map types of the thesis's Table 6.1; `k.pmap` is the file of kind `k`.
+pub const LAB_MAP_KINDS: [&str; 4] = ["planes", "hybrid", "trimesh", "pc"];
+
+impl Default for LabMapParams {
+    /// `patchnav experiment lab-timing`'s defaults.
+    fn default() -> LabMapParams {
+        LabMapParams { scene_seed: 0, scans: 8, scan_height: 0.5, scan_step_deg: None }
+    }
+}
+
+impl LabMapParams {
+    /// Checks the numbers.
+    pub fn validate(&self) -> Result<()> {
+        if self.scans == 0 || self.scans > 1000 {
+            bail!("--lab-scans must be between 1 and 1000, got {}", self.scans);
+        }
+        if let Some(step) = self.scan_step_deg
+            && !(step.is_finite() && step > 0.0 && step <= 30.0)
+        {
+            bail!("--lab-scan-step-deg must be above 0 and at most 30 degrees, got {step}");
+        }
+        if !(self.scan_height.is_finite() && self.scan_height > 0.0) {
+            bail!("the scan height must be a positive number of metres, got {}", self.scan_height);
+        }
+        Ok(())
+    }
+
+    /// The cache folder's name: every parameter, so different builds never share a folder.
+    pub fn key(&self) -> String {
+        let step = self.scan_step_deg.map_or_else(|| "s300".to_owned(), |s| s.to_string());
+        format!("lab-seed{}-scans{}-h{}-step{step}", self.scene_seed, self.scans, self.scan_height)
+    }
+
+    /// The arguments of `patchnav` that build the map of `kind` into `out`.
+    pub fn patchnav_args(&self, kind: &str, out: &Path) -> Vec<String> {
+        let backend = if kind == "pc" { "pointcloud" } else { "polygon" };
+        let mut a: Vec<String> = [
+            "--quiet",
+            "map",
+            "build",
+            "--scene",
+            "lab",
+            "--kind",
+            kind,
+            "--source",
+            "scans",
+            "--backend",
+            backend,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(["--scene-seed".into(), self.scene_seed.to_string()]);
+        a.extend(["--scans".into(), self.scans.to_string()]);
+        a.extend(["--scan-height".into(), self.scan_height.to_string()]);
+        if let Some(step) = self.scan_step_deg {
+            a.extend(["--scan-step-deg".into(), step.to_string()]);
+        }
+        a.extend(["--out".into(), out.display().to_string()]);
+        a
+    }
 }
 
 fn parse(args: &[String]) -> Result<Args> {
@@ -32,6 +126,7 @@ fn parse(args: &[String]) -> Result<Args> {
         list: false,
         matrix: Vec::new(),
         resume: false,
+        lab: LabMapParams::default(),
     };
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -43,6 +138,15 @@ fn parse(args: &[String]) -> Result<Args> {
             "--out" => parsed.out = it.next().context("--out needs a path")?.into(),
             "--list" => parsed.list = true,
             "--resume" => parsed.resume = true,
+            "--lab-scans" => {
+                let v = it.next().context("--lab-scans needs a value")?;
+                parsed.lab.scans = v.parse().with_context(|| format!("bad --lab-scans `{v}`"))?;
+            }
+            "--lab-scan-step-deg" => {
+                let v = it.next().context("--lab-scan-step-deg needs a value")?;
+                parsed.lab.scan_step_deg =
+                    Some(v.parse().with_context(|| format!("bad --lab-scan-step-deg `{v}`"))?);
+            }
             flag @ ("--scene" | "--backend" | "--planner" | "--seeds" | "--jobs") => {
                 let v = it.next().with_context(|| format!("{flag} needs a value"))?;
                 parsed.matrix.extend([flag.to_owned(), v.clone()]);
@@ -51,7 +155,75 @@ fn parse(args: &[String]) -> Result<Args> {
             name => parsed.names.push(name.to_owned()),
         }
     }
+    parsed.lab.validate()?;
     Ok(parsed)
+}
+
+/// Whether the selection runs a `lab-scans-*` scene of the matrix: the matrix runs, and no
+/// `--scene` is given or one names `lab-scans` or a `lab-scans-*` scene.
+fn runs_lab_scans(names: &[String], matrix: &[String]) -> bool {
+    let scenes: Vec<&str> = matrix
+        .chunks(2)
+        .filter(|f| f[0] == "--scene")
+        .flat_map(|f| f.get(1).map_or("", String::as_str).split(','))
+        .filter(|s| !s.is_empty())
+        .collect();
+    runs_matrix(names)
+        && (scenes.is_empty()
+            || scenes.iter().any(|s| *s == "lab-scans" || s.starts_with("lab-scans-")))
+}
+
+/// Whether `dir` holds a complete build newer than `binary`: all four map files and
+/// `build.json` (written last), whose modification time is not before the binary's.
+pub fn lab_maps_fresh(dir: &Path, binary: &Path) -> bool {
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let (Some(built), Some(bin)) = (modified(&dir.join("build.json")), modified(binary)) else {
+        return false;
+    };
+    built >= bin && LAB_MAP_KINDS.iter().all(|k| dir.join(format!("{k}.pmap")).is_file())
+}
+
+/// The folder of the lab's four maps from scans for `params`, built with the release
+/// `patchnav` unless a fresh build is there.
+fn lab_maps(params: &LabMapParams) -> Result<PathBuf> {
+    let root = crate::project_root();
+    let binary = crate::build_patchnav(&root)?;
+    let dir = root.join("target/bench/lab-maps").join(params.key());
+    if lab_maps_fresh(&dir, &binary) {
+        println!("lab maps from scans: reusing {}", dir.display());
+        return Ok(dir);
+    }
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let _ = std::fs::remove_file(dir.join("build.json"));
+    let mut commands = Vec::new();
+    for kind in LAB_MAP_KINDS {
+        let t0 = std::time::Instant::now();
+        let (tmp, out) = (dir.join(format!("{kind}.pmap.tmp")), dir.join(format!("{kind}.pmap")));
+        let args = params.patchnav_args(kind, &tmp);
+        crate::capture(Command::new(&binary).args(&args))
+            .with_context(|| format!("building the lab's {kind} map from scans"))?;
+        std::fs::rename(&tmp, &out)
+            .with_context(|| format!("renaming {} to {}", tmp.display(), out.display()))?;
+        println!(
+            "lab maps from scans: built {} in {:.1} s",
+            out.display(),
+            t0.elapsed().as_secs_f64()
+        );
+        commands.push(format!("patchnav {}", params.patchnav_args(kind, &out).join(" ")));
+    }
+    let manifest = serde_json::json!({
+        "scene": "lab",
+        "source": "scans",
+        "scene_seed": params.scene_seed,
+        "scans": params.scans,
+        "scan_height": params.scan_height,
+        "scan_step_deg": params.scan_step_deg,
+        "commands": commands,
+    });
+    let path = dir.join("build.json");
+    std::fs::write(&path, format!("{manifest:#}\n"))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(dir)
 }
 
 /// The case keys of the `roadmap` matrix that are complete in `results` (JSONL) for git
@@ -95,6 +267,9 @@ pub fn run(args: &[String]) -> Result<()> {
         return Ok(());
     }
     cmd.arg("--seed").arg(args.seed.to_string()).args(&args.names).args(&args.matrix);
+    if runs_lab_scans(&args.names, &args.matrix) {
+        cmd.env("PATCHNAV_LAB_MAPS", lab_maps(&args.lab)?);
+    }
     let provenance = crate::provenance::collect(args.seed);
     let revision = provenance.get("git_revision").and_then(Value::as_str).unwrap_or("").to_owned();
     if let Some(dir) = args.out.parent() {
@@ -214,5 +389,74 @@ mod tests {
         assert!(p.resume);
         assert!(parse(&["--seeds".to_owned()]).is_err());
         assert!(runs_matrix(&[]) && runs_matrix(&p.names) && !runs_matrix(&["tof".to_owned()]));
+        assert_eq!(p.lab, LabMapParams::default());
+        assert!(!runs_lab_scans(&p.names, &p.matrix), "--scene office only");
+        for bad in [&["--lab-scans", "0"][..], &["--lab-scans"], &["--lab-scan-step-deg", "NaN"]] {
+            let bad: Vec<String> = bad.iter().map(|s| s.to_string()).collect();
+            assert!(parse(&bad).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn lab_scans_scenes_get_maps_built_by_their_parameters() {
+        let strings = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let p =
+            parse(&strings(&["roadmap", "--scene", "lab,lab-scans", "--lab-scans", "3"])).unwrap();
+        assert!(runs_lab_scans(&p.names, &p.matrix));
+        assert!(runs_lab_scans(&[], &[]), "the whole matrix");
+        assert!(runs_lab_scans(&[], &strings(&["--scene", "lab-scans-pc", "--jobs", "2"])));
+        assert!(!runs_lab_scans(&strings(&["tof"]), &[]));
+        assert!(!runs_lab_scans(&[], &strings(&["--jobs", "2", "--scene", "lab"])));
+        // Every parameter is in the key.
+        let base = p.lab.clone();
+        assert_eq!(base.scans, 3);
+        let variants = [
+            LabMapParams { scene_seed: 1, ..base.clone() },
+            LabMapParams { scans: 4, ..base.clone() },
+            LabMapParams { scan_height: 0.6, ..base.clone() },
+            LabMapParams { scan_step_deg: Some(0.5), ..base.clone() },
+            base.clone(),
+        ];
+        let keys: HashSet<String> = variants.iter().map(LabMapParams::key).collect();
+        assert_eq!(keys.len(), variants.len(), "{keys:?}");
+        assert!(keys.iter().all(|k| !k.contains('/') && !k.contains(' ')));
+        // The patchnav command line builds from scans with the parameters.
+        let a = LabMapParams { scan_step_deg: Some(2.0), ..base }
+            .patchnav_args("pc", Path::new("d/pc.pmap"));
+        let line = a.join(" ");
+        assert!(line.contains("map build --scene lab --kind pc --source scans"), "{line}");
+        assert!(line.contains("--backend pointcloud") && line.contains("--scans 3"), "{line}");
+        assert!(line.contains("--scan-step-deg 2") && line.ends_with("--out d/pc.pmap"), "{line}");
+        let planes = LabMapParams::default().patchnav_args("planes", Path::new("p.pmap"));
+        assert!(planes.join(" ").contains("--backend polygon"));
+        assert!(!planes.iter().any(|a| a == "--scan-step-deg"));
+    }
+
+    #[test]
+    fn a_cached_build_is_fresh_only_when_complete_and_newer_than_patchnav() {
+        use std::time::{Duration, SystemTime};
+        let dir = tempfile::tempdir().unwrap();
+        let binary = dir.path().join("patchnav");
+        std::fs::write(&binary, "").unwrap();
+        let maps = dir.path().join("maps");
+        std::fs::create_dir(&maps).unwrap();
+        let touch = |p: &Path, t: SystemTime| {
+            std::fs::write(p, "x").unwrap();
+            std::fs::File::options().write(true).open(p).unwrap().set_modified(t).unwrap();
+        };
+        let now = SystemTime::now();
+        touch(&binary, now - Duration::from_secs(60));
+        for k in LAB_MAP_KINDS {
+            touch(&maps.join(format!("{k}.pmap")), now);
+        }
+        assert!(!lab_maps_fresh(&maps, &binary), "no build.json: interrupted");
+        touch(&maps.join("build.json"), now);
+        assert!(lab_maps_fresh(&maps, &binary));
+        touch(&binary, now + Duration::from_secs(60));
+        assert!(!lab_maps_fresh(&maps, &binary), "patchnav changed since");
+        touch(&binary, now - Duration::from_secs(60));
+        std::fs::remove_file(maps.join("pc.pmap")).unwrap();
+        assert!(!lab_maps_fresh(&maps, &binary), "a map is missing");
+        assert!(!lab_maps_fresh(&maps, &dir.path().join("no-such-binary")));
     }
 }

@@ -1,4 +1,5 @@
-//! `cargo xtask compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]`:
+//! `cargo xtask compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]
+//! [--lab-frames N] [--real-dir D]`:
 //! the project beside established systems on the same inputs, measured in one run
 //! (docs/comparison.md).
 //!
@@ -11,7 +12,9 @@
 //!   files from the same scans.
 //! * **segmentation**: PCL's organised multi-plane segmentation with concave hulls
 //!   (`compare/src/cmp_segment.cpp`) against `patchnav extract` on the shared floor-plan depth
-//!   image, quality scored against the floor plan's mesh as `peers planes` scores it.
+//!   image (scored against the floor plan's mesh as `peers planes` scores it), `--lab-frames`
+//!   simulated range-camera frames of the lab (scored against the scene's exact surfaces) and
+//!   the organised real frames of `shared/data/real` or `--real-dir` (time and coverage only).
 //!
 //! The C++ programs are built with CMake from Debian's packages into `target/compare-build/`;
 //! a missing package stops the command with the `apt-get` line to run, or is installed with
@@ -49,6 +52,10 @@ struct Args {
     seeds: u64,
     poses: usize,
     bench: PathBuf,
+    /// Simulated lab frames of the segmentation part.
+    lab_frames: usize,
+    /// The real frames' folder of the segmentation part (`None`: its default).
+    real_dir: Option<PathBuf>,
 }
 
 fn parse(args: &[String]) -> Result<Args> {
@@ -61,6 +68,8 @@ fn parse(args: &[String]) -> Result<Args> {
         seeds: 10,
         poses: 4,
         bench: root.join("../shared/bench"),
+        lab_frames: segmentation::LAB_FRAMES,
+        real_dir: None,
     };
     let mut any = false;
     let mut it = args.iter();
@@ -87,10 +96,19 @@ fn parse(args: &[String]) -> Result<Args> {
                     bail!("--poses must be between 1 and 64");
                 }
             }
+            "--lab-frames" => {
+                parsed.lab_frames =
+                    value()?.parse().context("--lab-frames takes a whole number")?;
+                if !(1..=64).contains(&parsed.lab_frames) {
+                    bail!("--lab-frames must be between 1 and 64");
+                }
+            }
+            "--real-dir" => parsed.real_dir = Some(value()?.into()),
             "--bench-dir" => parsed.bench = value()?.into(),
             other => bail!(
                 "unknown argument `{other}` (compare [planning|mapsize|segmentation|all] \
-                 [--install] [--seeds N] [--poses N] [--bench-dir D])"
+                 [--install] [--seeds N] [--poses N] [--lab-frames N] [--real-dir D] \
+                 [--bench-dir D])"
             ),
         }
     }
@@ -164,7 +182,12 @@ pub fn run(args: &[String]) -> Result<()> {
         part("mapsize", rows, table)?;
     }
     if args.segmentation {
-        let (rows, table) = segmentation::run(&env)?;
+        let mut options = segmentation::Options::from_env();
+        options.lab_frames = args.lab_frames;
+        if let Some(dir) = &args.real_dir {
+            options.real_dir = dir.clone();
+        }
+        let (rows, table) = segmentation::run_with(&env, &options)?;
         part("segmentation", rows, table)?;
     }
     let path = env.out.join("summary.md");

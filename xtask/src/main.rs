@@ -41,6 +41,8 @@ commands:
   bench --list                          list the benchmark names
   bench roadmap [--scene S] [--backend B] [--planner P] [--seeds N] [--jobs N] [--resume]
                                         the planning matrix (scenes x backends x planners x seeds);
+                                        scenes office, lab, lab-scans (maps built from simulated
+                                        scans: [--lab-scans N] [--lab-scan-step-deg D]);
                                         --resume skips cases already in the results for this git
                                         revision; also writes OMPL logs to target/bench/ompl/
   docs [--results F] [--out F]          generate docs/benchmarks.md (and docs/img/) from the results
@@ -49,6 +51,7 @@ commands:
   peers terrain [--peers-dir D] [--peers-build D] [--out F]
                                         Hough terrain classes beside a RANSAC ground plane (PCL, Open3D)
   compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]
+          [--lab-frames N] [--real-dir D]
                                         OMPL+FCL, OctoMap, PCL (built from compare/) beside ours
 ";
 

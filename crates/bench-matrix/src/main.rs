@@ -66,7 +66,8 @@ const BENCHES: &[Bench] = &[
     },
     Bench {
         name: "roadmap",
-        about: "Tables 5.3-5.11, Fig 6.4: scenes (office, lab) x backends x planners x seeds; \
+        about: "Tables 5.3-5.11, Fig 6.4: scenes (office, lab, lab-scans-{planes,hybrid,trimesh,pc} with \
+                $PATCHNAV_LAB_MAPS) x backends x planners x seeds; \
                 --scene, --backend, --planner (repeatable or comma-separated), --seeds N, --jobs N, \
                 --resume FILE (case keys to skip, one a line)",
         run: Run::Matrix(roadmap::run),

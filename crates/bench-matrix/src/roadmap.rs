@@ -15,7 +15,25 @@
 //!   give), an RRT (or PRM) grown from a free point near the south-west corner for
 //!   [`LAB_ITERATIONS`] iterations with no goal (thesis Algorithm 13 as run for §6.1), timed
 //!   at 100, 500 (the thesis's "useful number", L6813–6818) and 1000 iterations. Radius 0.3 m,
-//!   step 1 m (not given in the thesis for the Lab).
+//!   step 1 m (not given in the thesis for the Lab). Samples in the scene's box.
+//! * `lab-scans-planes`, `lab-scans-hybrid`, `lab-scans-trimesh`, `lab-scans-pc` (`--scene
+//!   lab-scans` selects all four) — Fig 6.4 as the thesis ran it: the lab's four map types
+//!   built from simulated ALRF scans ([`lab_maps`]; planes, hybrid and trimesh by patch
+//!   extraction, pc the raw scan points), read from the folder of map files named by
+//!   `$PATCHNAV_LAB_MAPS`, which `cargo xtask bench` builds with `patchnav map build --source
+//!   scans` and caches under `target/bench/lab-maps/`. Without it these scenes are skipped with
+//!   a note. Runs as `lab` (RRT and PRM, K = 100/500/1000, radius 0.3 m, step 1 m), but each
+//!   map samples in its own box (thesis L6460, as `patchnav experiment lab-timing`) and the
+//!   start is free on all four maps. The patch maps run on the four patch backends, the pc map
+//!   on `pointcloud` only (the thesis's Algorithm 10 for raw clouds); on the trimesh map a run
+//!   without `--backend` leaves out polygon and bbox6d (≈ 12 s per run there). Rows carry
+//!   `lab_maps`, the name of the folder (its name holds the build parameters).
+//!
+//! # Case keys
+//! `scene/backend/planner/seed`. The map type is part of the scene, so a key names the map and
+//! the backend holding it (`lab-scans-trimesh/rapier/rrt/3`: the trimesh map built from scans
+//! in rapier), `lab` keeps its exact-geometry rows, and documentation groups the scans rows by
+//! the scene prefix `lab-scans-`.
 //!
 //! # Backends
 //! `polygon` (the thesis's Simple), `bbox6d` (BB6D), `trimesh` (one parry BVH, OPCODE's role),
@@ -30,6 +48,7 @@
 //! the times stay per-run wall times, but runs compete for caches and memory bandwidth: every
 //! row records `jobs`, and timing tables should come from `--jobs 1`.
 
+mod lab_maps;
 mod lab_scene;
 mod planners;
 
@@ -39,11 +58,10 @@ use patch_map::{
     AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
     planar_patches_from_mesh, sample_patch_points,
 };
-use pointcloud::Aabb;
 use roadmap::metrics::{added_length, turn_angles, upper_quartile};
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, PlannerStatus, PlanningSpace, Problem,
-    Termination,
+    AnyOf, GoalReached, MaxIterations, PathMetrics, PlannerStatus, PlanningSpace, Problem,
+    ProblemFile, Termination,
 };
 use serde_json::{Value, json};
 use std::collections::HashSet;
@@ -54,7 +72,10 @@ use std::time::Instant;
 pub(crate) use planners::PLANNERS;
 
 /// The scenes of the matrix.
-pub(crate) const SCENES: [&str; 2] = ["office", "lab"];
+pub(crate) const SCENES: [&str; 6] =
+    ["office", "lab", "lab-scans-planes", "lab-scans-hybrid", "lab-scans-trimesh", "lab-scans-pc"];
+/// A `--scene` name selecting every `lab-scans-*` scene.
+const LAB_SCANS_GROUP: &str = "lab-scans";
 /// The backends, in the thesis's column order (Simple, BB6D, OPCODE, Bullet), then the
 /// point-cloud map.
 pub(crate) const BACKENDS: [&str; 5] = ["polygon", "bbox6d", "trimesh", "rapier", "pointcloud"];
@@ -93,11 +114,17 @@ pub(crate) struct MatrixArgs {
 impl MatrixArgs {
     /// Checks the selection against the known names.
     pub(crate) fn validate(&self) -> Result<()> {
-        for (what, given, known) in [
-            ("scene", &self.scenes, &SCENES[..]),
-            ("backend", &self.backends, &BACKENDS[..]),
-            ("planner", &self.planners, &PLANNERS[..]),
-        ] {
+        if let Some(bad) =
+            self.scenes.iter().find(|g| *g != LAB_SCANS_GROUP && !SCENES.contains(&g.as_str()))
+        {
+            bail!(
+                "unknown scene `{bad}`; known: {}, {LAB_SCANS_GROUP} (all lab-scans-*)",
+                SCENES.join(", ")
+            );
+        }
+        for (what, given, known) in
+            [("backend", &self.backends, &BACKENDS[..]), ("planner", &self.planners, &PLANNERS[..])]
+        {
             if let Some(bad) = given.iter().find(|g| !known.contains(&g.as_str())) {
                 bail!("unknown {what} `{bad}`; known: {}", known.join(", "));
             }
@@ -116,6 +143,21 @@ impl MatrixArgs {
 
     fn wants<'a>(given: &[String], all: &[&'a str]) -> Vec<&'a str> {
         all.iter().copied().filter(|n| given.is_empty() || given.iter().any(|g| g == n)).collect()
+    }
+
+    /// The scenes to run, in [`SCENES`] order (`lab-scans` stands for every `lab-scans-*`).
+    fn scenes(&self) -> Vec<&'static str> {
+        SCENES
+            .iter()
+            .copied()
+            .filter(|n| {
+                self.scenes.is_empty()
+                    || self
+                        .scenes
+                        .iter()
+                        .any(|g| g == n || (g == LAB_SCANS_GROUP && lab_maps::kind_of(n).is_some()))
+            })
+            .collect()
     }
 }
 
@@ -136,6 +178,8 @@ enum Mode {
 /// A scene ready to run: its maps, space, query and planners.
 struct Setup {
     scene: &'static str,
+    /// The folder name of the maps built from scans (`lab-scans-*` scenes), put in every row.
+    lab_maps: Option<String>,
     maps: Vec<(&'static str, AnyMap)>,
     space: PlanningSpace,
     query: Problem,
@@ -143,17 +187,45 @@ struct Setup {
     planners: Vec<&'static str>,
 }
 
-/// Runs the matrix; `emit` gets every row, the rows of one case together, `solved` last.
+/// Runs the matrix; `emit` gets every row, the rows of one case together, `solved` last. The
+/// `lab-scans-*` scenes read their maps from the folder named by `$PATCHNAV_LAB_MAPS`.
 pub(crate) fn run(args: &MatrixArgs, emit: &mut dyn FnMut(Value) -> Result<()>) -> Result<()> {
+    run_with(args, lab_maps::folder_from_env().as_deref(), emit)
+}
+
+/// [`run`] with the folder of the lab's maps built from scans (`None`: those scenes are
+/// skipped with a note).
+fn run_with(
+    args: &MatrixArgs,
+    lab_maps_folder: Option<&Path>,
+    emit: &mut dyn FnMut(Value) -> Result<()>,
+) -> Result<()> {
     args.validate()?;
     let backends = MatrixArgs::wants(&args.backends, &BACKENDS);
-    for scene in MatrixArgs::wants(&args.scenes, &SCENES) {
+    let mut scanned: Option<lab_maps::LabMaps> = None;
+    for scene in args.scenes() {
         let t0 = Instant::now();
-        let setup = match scene {
-            "office" => match office_setup(&backends)? {
+        let setup = match (scene, lab_maps::kind_of(scene)) {
+            ("office", _) => match office_setup(&backends)? {
                 Some(s) => s,
                 None => continue,
             },
+            (_, Some(kind)) => {
+                let Some(folder) = lab_maps_folder else {
+                    eprintln!(
+                        "SKIPPED: scene `{scene}` (no maps built from scans: set {} to a folder \
+                         of planes/hybrid/trimesh/pc .pmap files, as `cargo xtask bench` does)",
+                        lab_maps::LAB_MAPS_ENV
+                    );
+                    continue;
+                };
+                if scanned.is_none() {
+                    scanned = Some(lab_maps::load(folder, LAB_RADIUS)?);
+                }
+                let Some(maps) = scanned.as_mut() else { continue };
+                let backends = lab_scans_backends(kind, &backends, args.backends.is_empty());
+                lab_scans_setup(scene, kind, maps, &backends)?
+            }
             _ => lab_setup(&backends)?,
         };
         eprintln!(
@@ -338,6 +410,12 @@ fn run_case(
                 "status": status, "mode": mode, "max_iterations": cap, "jobs": jobs,
             })
         })
+        .map(|mut row| {
+            if let (Some(folder), Some(obj)) = (&setup.lab_maps, row.as_object_mut()) {
+                obj.insert("lab_maps".into(), folder.clone().into());
+            }
+            row
+        })
         .collect()))
 }
 
@@ -381,25 +459,6 @@ fn bench_dir() -> PathBuf {
     }
 }
 
-fn point(v: Option<&Value>, what: &str) -> Result<Point3> {
-    let a: Vec<Real> = v
-        .and_then(Value::as_array)
-        .with_context(|| format!("`{what}` is missing or not an array"))?
-        .iter()
-        .map(|x| x.as_f64().with_context(|| format!("`{what}` holds a non-number")))
-        .collect::<Result<_>>()?;
-    match a[..] {
-        [x, y, z] if a.iter().all(|c| c.is_finite()) => Ok(Point3::new(x, y, z)),
-        _ => bail!("`{what}` is not three finite numbers"),
-    }
-}
-
-fn number(v: &Value, key: &str) -> Result<Real> {
-    v.get(key)
-        .and_then(Value::as_f64)
-        .with_context(|| format!("`{key}` is missing or not a number"))
-}
-
 /// The office scene from the shared floor plan; `None` (with a note) when it is not there.
 fn office_setup(backends: &[&'static str]) -> Result<Option<Setup>> {
     let path = bench_dir().join("floorplan.json");
@@ -409,28 +468,10 @@ fn office_setup(backends: &[&'static str]) -> Result<Option<Setup>> {
         );
         return Ok(None);
     }
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let v: Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
-    let mesh = v.get("mesh").and_then(Value::as_str).context("`mesh` is missing")?;
-    let mesh = path.parent().unwrap_or(Path::new(".")).join(mesh);
-    let bounds = v.get("bounds").context("`bounds` is missing")?;
-    let bounds =
-        Aabb::new(point(bounds.get("min"), "bounds.min")?, point(bounds.get("max"), "bounds.max")?);
-    let radius = number(&v, "robot_radius")?;
-    let space = PlanningSpace::new(bounds, radius, number(&v, "max_step")?)
-        .context("bounds, robot_radius, max_step")?;
-    let tolerance = number(&v, "goal_tolerance")?;
-    let goals = v
-        .get("goals")
-        .and_then(Value::as_array)
-        .context("`goals` is missing")?
-        .iter()
-        .enumerate()
-        .map(|(i, g)| Ok(Goal { center: point(Some(g), &format!("goals[{i}]"))?, tolerance }))
-        .collect::<Result<Vec<_>>>()?;
-    let query = Problem { start: point(v.get("start"), "start")?, goals };
+    let p = ProblemFile::read(&path)?;
+    let space = p.space().with_context(|| path.display().to_string())?;
+    let query = p.query(&p.goals);
+    let (mesh, radius) = (p.mesh, p.robot_radius);
     let patches = planar_patches_from_mesh(
         &pointcloud::io::read_mesh(&mesh)?,
         &MeshToPatchesConfig::exact_cad(),
@@ -438,6 +479,7 @@ fn office_setup(backends: &[&'static str]) -> Result<Option<Setup>> {
     .0;
     Ok(Some(Setup {
         scene: "office",
+        lab_maps: None,
         maps: build_maps(backends, &patches, radius / 4.0)?,
         space,
         query,
@@ -455,10 +497,59 @@ fn lab_setup(backends: &[&'static str]) -> Result<Setup> {
     let space =
         PlanningSpace::new(bounds, LAB_RADIUS, LAB_STEP).context("the lab's planning space")?;
     let start =
-        lab_scene::corner_start(&maps.iter().map(|m| &m.1).collect::<Vec<_>>(), LAB_RADIUS)?;
+        lab_scene::corner_start(&maps.iter().map(|m| &m.1).collect::<Vec<_>>(), LAB_RADIUS, None)?;
     Ok(Setup {
         scene: "lab",
+        lab_maps: None,
         maps,
+        space,
+        query: Problem { start, goals: Vec::new() },
+        mode: Mode::Explore,
+        planners: LAB_PLANNERS.to_vec(),
+    })
+}
+
+/// The lab scene `scene` on the map of `kind` built from scans, in each of `backends` that can
+/// hold it; it samples in the map's own box (thesis L6460).
+/// Backends without a broad phase worth the name that a default run leaves out on the
+/// trimesh map from scans: polygon and bbox6d test each of its ~55,000 patches' boxes per step
+/// and take ≈ 12 s per 1000-iteration run (about 3,000× the trimesh backend).
+const SLOW_ON_SCANNED_TRIMESH: [&str; 2] = ["polygon", "bbox6d"];
+
+/// The backends a `lab-scans-*` scene runs: `selected`, less [`SLOW_ON_SCANNED_TRIMESH`] for the
+/// trimesh map when the backends were not named (`by_default`; a note says so).
+fn lab_scans_backends(
+    kind: &str,
+    selected: &[&'static str],
+    by_default: bool,
+) -> Vec<&'static str> {
+    if kind != "trimesh" || !by_default {
+        return selected.to_vec();
+    }
+    eprintln!(
+        "roadmap: lab-scans-trimesh: {} left out by default (≈ 12 s per run); name them with \
+         --backend to run them",
+        SLOW_ON_SCANNED_TRIMESH.join(" and ")
+    );
+    selected.iter().copied().filter(|b| !SLOW_ON_SCANNED_TRIMESH.contains(b)).collect()
+}
+
+fn lab_scans_setup(
+    scene: &'static str,
+    kind: &str,
+    maps: &mut lab_maps::LabMaps,
+    backends: &[&'static str],
+) -> Result<Setup> {
+    let bounds = maps.bounds(kind)?;
+    let space = PlanningSpace::new(bounds, LAB_RADIUS, LAB_STEP)
+        .with_context(|| format!("the planning space of the {kind} map"))?;
+    let start = maps.start;
+    let built =
+        maps.take_maps(kind, backends).with_context(|| format!("loading the {kind} map"))?;
+    Ok(Setup {
+        scene,
+        lab_maps: maps.folder.file_name().map(|n| n.to_string_lossy().into_owned()),
+        maps: built,
         space,
         query: Problem { start, goals: Vec::new() },
         mode: Mode::Explore,
@@ -480,6 +571,14 @@ mod tests {
             jobs: 2,
             skip: HashSet::new(),
         }
+    }
+
+    #[test]
+    fn the_scanned_trimesh_map_leaves_out_slow_backends_unless_they_are_named() {
+        let all: Vec<&'static str> = BACKENDS.to_vec();
+        assert_eq!(lab_scans_backends("planes", &all, true), all);
+        assert_eq!(lab_scans_backends("trimesh", &all, false), all);
+        assert_eq!(lab_scans_backends("trimesh", &all, true), ["trimesh", "rapier", "pointcloud"]);
     }
 
     #[test]
@@ -545,6 +644,75 @@ mod tests {
     }
 
     #[test]
+    fn lab_scans_scenes_plan_on_the_maps_of_a_folder() {
+        let dir = lab_maps::tests::TempDir::new("lab-scans-run");
+        lab_maps::tests::write_tiny_maps(&dir.0);
+        let a = MatrixArgs {
+            scenes: vec!["lab-scans".into()],
+            backends: Vec::new(),
+            seeds: 1,
+            ..args()
+        };
+        let mut rows = Vec::new();
+        run_with(&a, Some(&dir.0), &mut |r| {
+            rows.push(r);
+            Ok(())
+        })
+        .unwrap();
+        let cases: HashSet<&str> = rows.iter().map(|r| r["case"].as_str().unwrap()).collect();
+        // By default the trimesh map leaves out the two slow backends.
+        assert_eq!(cases.len(), 2 * 4 + 2 + 1, "planes, hybrid × 4 + trimesh × 2 + pc: {cases:?}");
+        for kind in ["planes", "hybrid", "trimesh"] {
+            for backend in ["polygon", "bbox6d", "trimesh", "rapier"] {
+                let slow = kind == "trimesh" && SLOW_ON_SCANNED_TRIMESH.contains(&backend);
+                let case = format!("lab-scans-{kind}/{backend}/rrt/3");
+                assert_eq!(cases.contains(case.as_str()), !slow, "{case}");
+            }
+        }
+        assert!(cases.contains("lab-scans-pc/pointcloud/rrt/3"));
+        let folder = dir.0.file_name().unwrap().to_str().unwrap();
+        assert!(rows.iter().all(|r| r["lab_maps"] == folder && r["mode"] == "explore"));
+        // Same seed, same start, same exact map: the planes tree is the same in polygon and
+        // bbox6d (both exact).
+        let vertices = |case: &str| {
+            rows.iter().find(|r| r["case"] == case && r["metric"] == "vertices").unwrap()["value"]
+                .clone()
+        };
+        assert_eq!(
+            vertices("lab-scans-planes/polygon/rrt/3"),
+            vertices("lab-scans-planes/bbox6d/rrt/3")
+        );
+        // One scene and backend, resumed; without the folder the scenes are skipped.
+        let one = MatrixArgs {
+            scenes: vec!["lab-scans-trimesh".into()],
+            backends: vec!["rapier".into(), "pointcloud".into()],
+            ..a.clone()
+        };
+        let mut again = Vec::new();
+        run_with(&one, Some(&dir.0), &mut |r| {
+            again.push(r);
+            Ok(())
+        })
+        .unwrap();
+        assert!(!again.is_empty());
+        assert!(again.iter().all(|r| r["case"] == "lab-scans-trimesh/rapier/rrt/3"));
+        let skip = HashSet::from(["lab-scans-trimesh/rapier/rrt/3".to_owned()]);
+        let mut none = Vec::new();
+        run_with(&MatrixArgs { skip, ..one.clone() }, Some(&dir.0), &mut |r| {
+            none.push(r);
+            Ok(())
+        })
+        .unwrap();
+        run_with(&one, None, &mut |r| {
+            none.push(r);
+            Ok(())
+        })
+        .unwrap();
+        assert!(none.is_empty());
+        assert!(MatrixArgs { scenes: vec!["lab-scans-moon".into()], ..a }.validate().is_err());
+    }
+
+    #[test]
     fn medial_planners_cannot_run_on_the_point_cloud_map() {
         let mut rows = Vec::new();
         let a = MatrixArgs { planners: vec!["ma-rrt".into()], ..args() };
@@ -561,9 +729,12 @@ mod tests {
             0.075,
         )
         .unwrap();
-        let space =
-            PlanningSpace::new(Aabb::new(Point3::origin(), Point3::new(1.0, 1.0, 1.0)), 0.1, 0.5)
-                .unwrap();
+        let space = PlanningSpace::new(
+            pointcloud::Aabb::new(Point3::origin(), Point3::new(1.0, 1.0, 1.0)),
+            0.1,
+            0.5,
+        )
+        .unwrap();
         for p in ["ma-rrt", "ma-prm", "evasion-rrt"] {
             assert!(planners::make_planner(p, &map, space, 0).is_err(), "{p}");
         }

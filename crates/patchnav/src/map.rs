@@ -5,12 +5,21 @@
 //!
 //! `patchnav map build --scene lab --kind planes|hybrid|trimesh|pc --backend B --out MAP`
 //! builds the thesis's map types (§6.1, Table 6.1) from a synthetic scene instead
-//! ([`crate::scene_map`]: planes, hybrid and trimesh from the scene's exact geometry, pc from
-//! simulated ALRF scans), the maps `patchnav experiment lab-timing` and `lab-volume` plan on.
+//! ([`crate::scene_map`]), the maps `patchnav experiment lab-timing` and `lab-volume` plan on.
+//! The pc map is always the simulated ALRF scans; `--source` says where the planes, hybrid and
+//! trimesh maps come from: `scene` (the default) takes the scene's exact geometry, `scans`
+//! extracts patches from the simulated scans as the thesis built its maps
+//! ([`MapSource::Scans`], the lab experiments' default). The scan options (`--scans`,
+//! `--scan-height`, `--scan-step-deg`, `--scene-seed`) have the lab experiments' names and
+//! defaults, so `map build --source scans` writes the maps `lab-timing` builds in memory;
+//! `cargo xtask bench roadmap` plans on maps built this way.
 
 use crate::input::InputArgs;
 use crate::progress::Progress;
-use crate::scene_map::{MapKind, ScanSetup, SceneSurfaces, Tessellation, scan_points};
+use crate::scene_map::{
+    MapKind, MapSource, ScanSetup, SceneSurfaces, Tessellation, extracted_patches, scan_clouds,
+    scan_points,
+};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use patch_core::{FromPatches, Patch, PatchMap, Point3};
@@ -72,12 +81,24 @@ pub struct BuildArgs {
     /// With --scene: the thesis's map type (pc needs --backend pointcloud).
     #[arg(long, value_enum, requires = "scene")]
     pub kind: Option<MapKind>,
+    /// With --scene: where the planes, hybrid and trimesh maps come from: the scene's exact
+    /// geometry, or patch extraction from simulated ALRF scans (as the thesis built its maps;
+    /// the pc map is always the scans).
+    #[arg(long, value_enum, default_value_t = MapSource::Scene, requires = "scene")]
+    pub source: MapSource,
     /// With --scene: seed of the scene, the scan poses and the sensor noise.
     #[arg(long, default_value_t = 0)]
     pub scene_seed: u64,
-    /// With --scene --kind pc: number of simulated ALRF scans.
-    #[arg(long, default_value_t = 8)]
-    pub scans: usize,
+    /// With --scene (--kind pc, or --source scans): number of simulated ALRF scans (the
+    /// thesis's Lab has 29).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub scans: u64,
+    /// With --scene: height of the scanner above the floor, metres.
+    #[arg(long, default_value_t = 0.5)]
+    pub scan_height: f64,
+    /// With --scene: angular step of the simulated ALRF in degrees (default: the S300's 0.5°).
+    #[arg(long)]
+    pub scan_step_deg: Option<f64>,
     /// The backend of the new map.
     #[arg(long, value_enum)]
     pub backend: BackendChoice,
@@ -175,16 +196,38 @@ fn scene_source(
     }
     let scene = scene_sim::scene_by_name(name, args.scene_seed)
         .with_context(|| format!("building scene `{name}`"))?;
-    let t = Tessellation::lab();
-    let surfaces = SceneSurfaces::of(&scene, &t)?;
-    Ok(match surfaces.patches(kind, &t)? {
+    if !(args.scan_height.is_finite() && args.scan_height > 0.0) {
+        bail!("--scan-height must be a positive number of metres, got {}", args.scan_height);
+    }
+    let setup = ScanSetup {
+        scans: args.scans as usize,
+        height: args.scan_height,
+        step_deg: args.scan_step_deg,
+        seed: args.scene_seed,
+    };
+    let patches = match (kind, args.source) {
+        (MapKind::Pc, _) => None,
+        (_, MapSource::Scene) => {
+            let t = Tessellation::lab();
+            SceneSurfaces::of(&scene, &t)?.patches(kind, &t)?
+        }
+        (_, MapSource::Scans) => {
+            let clouds = scan_clouds(&scene, &setup)?;
+            extracted_patches(&clouds, kind)
+                .with_context(|| format!("extracting the {kind} map from {} scans", args.scans))?
+        }
+    };
+    Ok(match patches {
         Some(patches) => {
-            progress.say(format!("scene `{name}`, {kind} map: {} patches", patches.len()));
+            let from = match args.source {
+                MapSource::Scene => "exact geometry".to_owned(),
+                MapSource::Scans => format!("{} ALRF scans", args.scans),
+            };
+            progress
+                .say(format!("scene `{name}`, {kind} map from {from}: {} patches", patches.len()));
             Source::Patches(patches)
         }
         None => {
-            let setup =
-                ScanSetup { scans: args.scans, height: 0.5, step_deg: None, seed: args.scene_seed };
             let points: Vec<Point3> = scan_points(&scene, &setup)?.into_iter().flatten().collect();
             progress.say(format!(
                 "scene `{name}`, pc map: {} ALRF scans, {} points",
@@ -313,4 +356,70 @@ pub fn describe(path: &Path) -> Result<String> {
     writeln!(out, "memory bytes:    {}", map.memory_bytes())?;
     writeln!(out, "file bytes:      {file_bytes}")?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser, Debug)]
+    struct Cli {
+        #[command(subcommand)]
+        map: MapCommand,
+    }
+
+    /// `patchnav map ARGS[1..]` (`args[0]` is `map`).
+    fn cli(args: &[&str]) -> Result<MapCommand, clap::Error> {
+        assert_eq!(args.first(), Some(&"map"));
+        Cli::try_parse_from([&["patchnav map"], &args[1..]].concat()).map(|c| c.map)
+    }
+
+    /// One coarse scan (2° steps) keeps extraction fast in the dev profile.
+    const TOY_SCAN: [&str; 4] = ["--scans", "1", "--scan-step-deg", "2"];
+
+    #[test]
+    fn planes_from_scans_are_extracted_patches_inside_the_lab() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("planes.pmap");
+        let base = ["map", "build", "--scene", "lab", "--kind", "planes", "--backend", "polygon"];
+        let from_scans = [&base[..], &["--source", "scans"], &TOY_SCAN, &["--out"]].concat();
+        let command = cli(&[&from_scans[..], &[out.to_str().unwrap()]].concat()).unwrap();
+        run(&command, &Progress::new(true)).unwrap();
+        let map = open_map(&out).unwrap();
+        assert_eq!(map.backend(), "polygon");
+        let scanned = map.patches().unwrap();
+        assert!(scanned.len() >= 3, "floor and walls at least: {}", scanned.len());
+        assert!(scanned.iter().all(|p| p.as_planar().is_some()), "planes only");
+        // Extracted from noisy scans of the 12 × 9 × 4 m room: inside it up to the noise.
+        let b = map_bounds(&map);
+        assert!(b.min.x > -0.2 && b.min.y > -0.2 && b.max.x < 12.2 && b.max.y < 9.2, "{b:?}");
+        assert!(b.extents().x > 3.0 && b.extents().z > 1.0, "{b:?}");
+
+        // The default source stays the exact geometry, which differs from one scan's patches.
+        let exact = dir.path().join("exact.pmap");
+        let command = cli(&[&base[..], &TOY_SCAN, &["--out", exact.to_str().unwrap()]].concat());
+        run(&command.unwrap(), &Progress::new(true)).unwrap();
+        let exact = open_map(&exact).unwrap();
+        assert_ne!(exact.patches().unwrap().len(), scanned.len());
+        let area = |p: &[Patch]| p.iter().map(Patch::area).sum::<f64>();
+        assert!(area(scanned) < area(exact.patches().unwrap()), "one scan sees less");
+    }
+
+    #[test]
+    fn scan_options_are_checked() {
+        let out = ["--out", "x.pmap"];
+        let scene = ["map", "build", "--scene", "lab", "--kind", "pc", "--backend", "pointcloud"];
+        assert!(cli(&[&scene[..], &["--scans", "0"], &out].concat()).is_err());
+        assert!(cli(&[&scene[..], &["--source", "moon"], &out].concat()).is_err());
+        // --source belongs to --scene.
+        let file = ["map", "build", "in.obj", "--backend", "polygon", "--source", "scans"];
+        assert!(cli(&[&file[..], &out].concat()).is_err());
+        assert!(cli(&["map", "build", "in.obj", "--backend", "polygon", "--out", "x"]).is_ok());
+        for bad in ["--scan-height=-1", "--scan-height=NaN", "--scan-step-deg=0"] {
+            let c = cli(&[&scene[..], &[bad], &out].concat()).unwrap();
+            let e = run(&c, &Progress::new(true)).unwrap_err();
+            assert!(!format!("{e:#}").is_empty());
+        }
+    }
 }

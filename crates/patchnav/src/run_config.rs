@@ -3,9 +3,11 @@
 //! Table 6.1 that the input allows in the chosen backends; plans with the chosen planners and
 //! seeds from one start to the goals on every map; optionally filters a time-of-flight frame
 //! (AAT + unwrapping, thesis §2.5) and classifies a terrain frame (plane Hough transform,
-//! Ch. 4); and writes `results.json`, `report.html` (the demo's report; the RRT timing and
-//! explored-volume sections read "not computed") and the 3D files into the output folder, with
-//! a summary on standard output.
+//! Ch. 4); optionally times RRTs against iterations (`[timing]`, Fig 6.4) and compares the
+//! volume explored on every map (`[volume]`, Tables 6.2 / 6.4, Fig 6.1); and writes
+//! `results.json`, `report.html` (the demo's report; a section without its `[timing]` or
+//! `[volume]` reads "not computed") and the 3D files into the output folder, with a summary on
+//! standard output.
 //!
 //! # The configuration file
 //!
@@ -16,15 +18,17 @@
 //! |---|---|---|
 //! | `input.scans` | — | scan files in their sensor frames (`.ply .pcd .3d .bin .xyz .png`); exactly one of `scans`, `mesh`, `map`, `cloud` |
 //! | `input.poses` | each scan's own pose (PLY/PCD header, 3DTK `.pose`) | a `poses.json` as `patchnav simulate` writes and `patchnav extract --poses` reads, matched by file name |
-//! | `input.mesh` | — | an OBJ mesh: coplanar faces become planar patches, the rest trimesh patches |
+//! | `input.mesh` | — | an OBJ mesh: coplanar faces become planar patches (faces that make no valid polygon: trimesh patches) |
 //! | `input.map` | — | a map file (`.pmap`) of any backend |
 //! | `input.cloud` | — | a point cloud in the world frame (the `pc` map) |
 //! | `input.name` | the configuration file's stem | the data set's name in the report |
 //! | `input.skip_non_finite` | `false` | drop NaN points of unorganised clouds instead of failing |
-//! | `maps.types` | all the input allows: scans `planes hybrid trimesh pc`, mesh `planes hybrid pc`, map file its own type, cloud `pc` | map types to build |
+//! | `maps.types` | all the input allows: scans and mesh `planes hybrid trimesh pc`, map file its own type, cloud `pc` | map types to build |
 //! | `maps.backends` | `["trimesh"]` (a map file: its own backend) | backends each patch map is loaded into (`polygon bbox6d trimesh rapier`); one Table 6.1 row and one set of planning runs per backend; the `pc` map is always `pointcloud` |
 //! | `maps.sensor` | `"alrf"` | extraction presets for scans: `alrf`, `range-camera`, `exact` |
 //! | `maps.spacing` | `0.05` | mesh input: sample spacing of its `pc` map, metres |
+//! | `maps.mesh_edge` | none (unsplit) | mesh input: longest triangle edge of its `trimesh` map, metres |
+//! | `maps.max_patch_triangles` | `324` | mesh input: most triangles per patch of its `trimesh` map |
 //! | `plan.start` | — (required) | `[x, y, z]`, metres; must be free on every map |
 //! | `plan.goals` | — (required) | `[[x, y, z], ...]` |
 //! | `plan.radius` | `0.3` | robot radius, metres |
@@ -45,6 +49,13 @@
 //! | `terrain.axes` | camera for organised frames, lidar otherwise | `camera` or `lidar` |
 //! | `terrain.max_range` | none | keep points within this horizontal range, metres |
 //! | `terrain.sectors` | `3` | azimuth sectors of the ±45° forward view |
+//! | `timing.iterations` | `3000` | iterations of every timed RRT (K of Fig 6.4) |
+//! | `timing.checkpoints` | `20` | times recorded per run (every K/N iterations, and at 100, 500, 1000) |
+//! | `timing.seeds` | `[1, …, 8]` | seeds; one run per seed from every start on every map |
+//! | `timing.starts` | `[plan.start]` | `[[x, y, z], ...]`; each must be free on every map |
+//! | `volume.planner` | `"rrt"` | `rrt` (Table 6.2) or `prm` (Table 6.4) |
+//! | `volume.iterations`, `volume.seeds`, `volume.starts` | `[timing]`'s, else as in `[timing]` | the runs whose roadmaps fill the grid |
+//! | `volume.cells` | `256` | voxels per axis of the grid covering every map (1–1024) |
 //! | `output.dir` | `"out/run"` | output folder |
 //! | `output.write_3d` | `true` | write the map meshes, roadmaps, paths and the ToF cloud |
 //!
@@ -54,6 +65,19 @@
 //!   own box (thesis L6460), stopping when every goal is reached or the budget is spent.
 //! * Planners that need a patch map (`evasion-rrt`, `ma-prm`, `ma-rrt`, thesis Table 5.2) are
 //!   skipped on the `pc` map, with a line in the summary.
+//! * `[timing]` and `[volume]` run as the demo's timing and volume stage
+//!   ([`crate::demo::pipeline::explore`]): RRT (Algorithm 13) or PRM (Algorithm 14) without
+//!   goals, each map sampled in its own box, one run per start and seed, the explored space
+//!   (every edge, every free vertex) rasterised into one grid covering all maps. Their defaults
+//!   are the demo's default scale; when `[volume]` asks for the RRT with `[timing]`'s
+//!   iterations, seeds and starts (its defaults), the timed runs fill the grid, as in the demo.
+//!   The demo starts at the lab's room corners; here the starts are the user's.
+//! * A mesh's `trimesh` map is its surfaces as triangles (planar patches triangulated by
+//!   constrained Delaunay), split to `maps.mesh_edge` if given and cut into patches of at most
+//!   `maps.max_patch_triangles`, as the simulated scenes' trimesh maps
+//!   ([`crate::scene_map::SceneSurfaces::patches`]); unsplit it has the planes map's geometry,
+//!   so the two differ only in their collision objects. `mesh_edge = 0.1` gives the lab
+//!   experiments' triangle size, which stands in for the scan grid of naive trimesh growing.
 //! * Without a simulation's truth, the ToF section's wrapped / unwrapped-correctly / wrong
 //!   percentages and the terrain's true class are unknown.
 
@@ -91,6 +115,11 @@ pub fn run(args: &RunArgs, progress: &Progress) -> Result<()> {
     progress.say(summary(&config, &results, &skipped)?.trim_end());
     progress.report(format!("report: {}", html.display()));
     Ok(())
+}
+
+/// `n` and `what`, with an `s` unless `n` is 1.
+fn plural(n: usize, what: &str) -> String {
+    format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
 
 /// The summary printed on standard output.
@@ -164,6 +193,40 @@ fn summary(
     }
     for line in skipped {
         writeln!(out, "  {line}")?;
+    }
+    if let Some(t) = &config.timing {
+        let medians: Vec<String> = r
+            .timing
+            .iter()
+            .filter_map(|c| Some(format!("{} {:.1} ms", c.map, c.median_ms.last()?)))
+            .collect();
+        writeln!(
+            out,
+            "rrt timing ({} × {}, median at {} iterations): {}",
+            plural(t.starts.len(), "start"),
+            plural(t.seeds.len(), "seed"),
+            t.iterations,
+            medians.join(", ")
+        )?;
+    }
+    if let Some(v) = &r.volume {
+        let volumes: Vec<String> =
+            v.maps.iter().zip(&v.volumes_m3).map(|(m, x)| format!("{m} {x:.2} m³")).collect();
+        writeln!(
+            out,
+            "explored volume ({}, {} runs per map of {} iterations, cells of {:.3} m): {}",
+            v.planner,
+            v.runs,
+            v.iterations,
+            v.cell,
+            volumes.join(", ")
+        )?;
+        if let Some((x, a, b)) = v.largest_difference() {
+            writeln!(
+                out,
+                "  largest difference: {x:.3} % of the {a} map's volume not in the {b} map's"
+            )?;
+        }
     }
     let stages: Vec<String> =
         r.stages.iter().map(|s| format!("{} {:.2} s", s.stage, s.seconds)).collect();

@@ -174,13 +174,18 @@ fn mesh_room_with_one_planner() {
     let r = results(&out);
     let kinds: Vec<&str> =
         r["maps"].as_array().unwrap().iter().map(|m| m["kind"].as_str().unwrap()).collect();
-    assert_eq!(kinds, ["planes", "hybrid", "pc"]);
+    assert_eq!(kinds, ["planes", "hybrid", "trimesh", "pc"]);
     // 6 room faces + 5 visible faces of the wall (its bottom lies on the floor, still a face).
     let planar = r["maps"][0]["planar_patches"].as_u64().unwrap();
     assert!((6..=12).contains(&planar), "{planar}");
+    // The trimesh map: the same surfaces as triangles, unsplit (no maps.mesh_edge).
+    let trimesh = &r["maps"][2];
+    assert_eq!(trimesh["planar_patches"], 0);
+    assert_eq!(trimesh["trimesh_patches"].as_u64().unwrap(), planar);
+    assert_eq!(trimesh["triangles"], r["maps"][0]["triangles"]);
     assert_eq!(r["scene"]["name"], "room");
     let plans = r["plans"].as_array().unwrap();
-    assert_eq!(plans.len(), 3 * 2);
+    assert_eq!(plans.len(), 4 * 2);
     for p in plans {
         assert_eq!(p["planner"], "rrt");
         assert_eq!(p["solved"], true, "{}", p["map"]);
@@ -211,7 +216,17 @@ fn bad_configs_fail_with_one_line() {
             "[input]\nmesh = \"room.obj\"\n[plan]\nstart = [1.0, 1.0, 1.0]\ngoals = [[5.0, 1.0, 1.0]]\nplanners = [\"dijkstra\"]\n".to_owned(),
             "plan.planners[0]: unknown value `dijkstra`",
         ),
-        (format!("[input]\nmesh = \"room.obj\"\n[maps]\ntypes = [\"trimesh\"]\n{ROOM_PLAN}"), "maps.types"),
+        (format!("[input]\nmesh = \"room.obj\"\n[maps]\ntypes = [\"voxels\"]\n{ROOM_PLAN}"), "maps.types[0]: unknown value `voxels`"),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[timing]\niterations = -5\n"), "timing.iterations must be in 1..="),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[volume]\ncells = 0\n"), "volume.cells must be in 1..=1024, not 0"),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[volume]\nplanner = \"rrt-star\"\n"), "volume.planner: unknown value `rrt-star`"),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[timing]\nseeds = [-1]\n"), "timing.seeds: invalid value"),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[timing]\nstarts = [[1.0, 1.0, 1.0], [9.0, 1.0, 1.0]]\n"),
+            "timing.starts[1] (9, 1, 1) is outside the planes map's box"),
+        (format!("[input]\nmesh = \"room.obj\"\n{ROOM_PLAN}[volume]\nstarts = [[2.6, 1.0, 1.0]]\n"),
+            "volume.starts[0] (2.6, 1, 1) is not free on the planes map"),
+        (format!("[input]\nmesh = \"room.obj\"\n[maps]\ntypes = [\"planes\"]\nmesh_edge = 0.5\n{ROOM_PLAN}"),
+            "maps.mesh_edge applies to the trimesh map"),
         ("[input]\nmesh = \"room.obj\"\n[plan]\ngoals = [[5.0, 1.0, 1.0]]\n".to_owned(), "missing field `start`"),
         ("[input]\nmesh = \"room.obj\"\n[plan]\nstart = [2.6, 1.0, 1.0]\ngoals = [[5.0, 1.0, 1.0]]\n".to_owned(),
             "plan.start (2.6, 1, 1) is not free on the planes map"),
@@ -226,4 +241,114 @@ fn bad_configs_fail_with_one_line() {
         assert_one_line_error(&o, needle);
     }
     assert!(!d.join("out/run/results.json").exists(), "no results from a bad config");
+}
+
+/// Every number of `v` (an array of numbers).
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array().expect("an array").iter().map(|x| x.as_f64().expect("a number")).collect()
+}
+
+#[test]
+fn mesh_room_timing_and_volume_on_planes_and_trimesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("room.obj"), room_obj()).unwrap();
+    let config = format!(
+        "[input]\nmesh = \"room.obj\"\n[maps]\ntypes = [\"planes\", \"trimesh\"]\nmesh_edge = 0.5\n\
+         {ROOM_PLAN}[timing]\niterations = 200\ncheckpoints = 4\nseeds = [1, 2, 3]\n\
+         starts = [[1.0, 1.0, 1.0], [5.0, 3.0, 1.5]]\n[volume]\ncells = 40\n[output]\nwrite_3d = false\n"
+    );
+    std::fs::write(d.join("room.toml"), config).unwrap();
+    let o = patchnav(&["run", d.join("room.toml").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("rrt timing (2 starts × 3 seeds") && text.contains("explored volume"));
+    let out = d.join("out/run");
+    let r = results(&out);
+
+    // The planes / trimesh pair: the same surfaces, the trimesh map split into 0.5 m triangles.
+    let (planes, trimesh) = (&r["maps"][0], &r["maps"][1]);
+    assert_eq!(
+        (planes["kind"].as_str(), trimesh["kind"].as_str()),
+        (Some("planes"), Some("trimesh"))
+    );
+    assert_eq!(trimesh["planar_patches"], 0);
+    assert!(
+        trimesh["triangles"].as_u64().unwrap() > 10 * planes["triangles"].as_u64().unwrap(),
+        "{trimesh}"
+    );
+
+    // Fig 6.4: one curve per map, checkpoints rising to K, times rising, quartiles ordered.
+    let timing = r["timing"].as_array().unwrap();
+    let names: Vec<&str> = timing.iter().map(|c| c["map"].as_str().unwrap()).collect();
+    assert_eq!(names, ["planes", "trimesh"]);
+    for c in timing {
+        let k = numbers(&c["iterations"]);
+        assert!(k.len() >= 3 && k.windows(2).all(|w| w[0] < w[1]), "{k:?}");
+        assert_eq!(*k.last().unwrap(), 200.0);
+        let (q1, m, q3) = (numbers(&c["q1_ms"]), numbers(&c["median_ms"]), numbers(&c["q3_ms"]));
+        assert!(m.windows(2).all(|w| w[0] <= w[1]) && m[0] > 0.0, "{m:?}");
+        for i in 0..m.len() {
+            assert!(q1[i] <= m[i] && m[i] <= q3[i], "{q1:?} {m:?} {q3:?}");
+        }
+    }
+
+    // Table 6.2: from the timed runs (the defaults), two maps, percentages off the diagonal.
+    let v = &r["volume"];
+    assert_eq!(v["planner"], "rrt");
+    assert_eq!((v["runs"].as_u64(), v["iterations"].as_u64()), (Some(6), Some(200)));
+    assert_eq!(v["maps"], serde_json::json!(["planes", "trimesh"]));
+    // The room (6 × 4 × 2.5 m) less the wall, grown by the robot radius at most.
+    let free = 6.0 * 4.0 * 2.5 - 1.0 * 2.5 * 2.5;
+    for x in numbers(&v["volumes_m3"]) {
+        assert!(x > 0.1 * free && x < 6.6 * 4.6 * 3.1, "{x}");
+    }
+    let table = v["table"].as_array().unwrap();
+    for (i, row) in table.iter().enumerate() {
+        for (j, cell) in row.as_array().unwrap().iter().enumerate() {
+            if i == j {
+                assert!(cell.is_null());
+            } else {
+                // The same surfaces, the same seeds: nearly the same space explored.
+                let p = cell.as_f64().unwrap();
+                assert!((0.0..5.0).contains(&p), "{i} not in {j}: {p}");
+            }
+        }
+    }
+    let size = numbers(&v["slice_size"]);
+    let bits = v["slice_bits"].as_array().unwrap();
+    assert_eq!(bits.len(), (size[0] * size[1]) as usize);
+    assert!(bits.iter().any(|b| b == 0b11), "no cell explored on both maps");
+    let cell = v["cell"].as_f64().unwrap();
+    assert!(
+        (v["slice_z"].as_f64().unwrap() - 1.0).abs() <= cell,
+        "the slice holds the first start"
+    );
+
+    // The report draws both sections.
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("5. Explored volume") && html.contains("Time against iterations"));
+    for missing in ["Explored volume: not computed", "Time against iterations: not computed"] {
+        assert!(!html.contains(missing), "{missing}");
+    }
+    assert!(html.contains("Thesis Table 6.2 (RRT, Lab)") && html.contains("RRT, 6 runs per map"));
+
+    // The PRM's volume alone: its own runs from the plan's start, no timing.
+    let config = format!(
+        "[input]\nmesh = \"room.obj\"\n[maps]\ntypes = [\"planes\", \"pc\"]\n{ROOM_PLAN}\
+         [volume]\nplanner = \"prm\"\niterations = 150\nseeds = [5]\ncells = 24\n\
+         [output]\nwrite_3d = false\ndir = \"prm\"\n"
+    );
+    std::fs::write(d.join("prm.toml"), config).unwrap();
+    let o = patchnav(&["run", d.join("prm.toml").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = results(&d.join("prm"));
+    assert!(r["timing"].as_array().unwrap().is_empty());
+    let v = &r["volume"];
+    assert_eq!((v["planner"].as_str(), v["runs"].as_u64()), (Some("prm"), Some(1)));
+    assert_eq!(v["maps"], serde_json::json!(["planes", "pc"]));
+    assert!(numbers(&v["volumes_m3"]).iter().all(|x| *x > 1.0));
+    let html = std::fs::read_to_string(d.join("prm/report.html")).unwrap();
+    assert!(html.contains("Thesis Table 6.4 (PRM, Lab)"));
+    assert!(html.contains("Time against iterations: not computed"));
 }

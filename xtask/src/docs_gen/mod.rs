@@ -1,36 +1,43 @@
 //! `cargo xtask docs`: generates `docs/benchmarks.md` (and its plot, `docs/img/`) from the rows
 //! of the `roadmap` matrix in `target/bench/results.jsonl`.
 //!
-//! The page holds every thesis table the matrix reproduces — Table 5.3 (median time to reach the
-//! four ROIs of the office) and Table 5.5 (median added path length) per planner and backend,
+//! The page holds every thesis table the matrix reproduces — the office benchmark's Tables
+//! 5.3–5.11 (median time to reach the four ROIs and its quartiles, added path length, steep and
+//! total turns at the median and both quartiles, curviness; [`office`]) per planner and backend,
 //! and the lab RRT time per map at K = 500 (Fig 6.4, whose numbers the thesis gives only as
-//! bounds in its prose, L6813–6818) — with the thesis's figure beside ours and the ratio
-//! ours / thesis, one SVG plot, the provenance of the rows used and the command that made them.
+//! bounds in its prose, L6813–6818) — with the thesis's figure beside ours (from
+//! [`roadmap::thesis`]) and the ratio ours / thesis, one SVG plot, the provenance of the rows
+//! used and the command that made them. A table whose metric the rows lack says so instead.
 //!
-//! Rows used: those of the git revision of the last matrix row in the file; of several rows of
-//! one case and metric the last one. Medians and quartiles are over the successful runs, as in
+//! Rows used: per scene, those of the git revision of the scene's last matrix row in the file
+//! (scenes may be run at different revisions: `--scene office`, then `--scene lab`); of several
+//! rows of one case and metric the last one. Medians and quartiles are over the successful runs, as in
 //! the thesis (L6119–6121), interpolated between closest ranks (Hyndman & Fan type 7, the method
 //! of `roadmap::metrics::quantile`).
 
 mod lab;
+mod office;
 
 use anyhow::{Context, Result, bail};
-use lab::lab_table;
+use lab::{lab_scans_section, lab_table};
+use office::{office_sections, office_time_svg};
+use roadmap::thesis;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// The matrix's backends in the thesis's column order, with the thesis's name for each.
+/// The matrix's backends in the thesis's column order, with the thesis's name for each
+/// ([`thesis::OFFICE_COLUMNS`]; the point-cloud map has no counterpart in its tables).
 const BACKENDS: [(&str, &str); 5] = [
-    ("polygon", "Simple"),
-    ("bbox6d", "BB6D"),
-    ("trimesh", "OPCODE"),
-    ("rapier", "Bullet"),
+    ("polygon", thesis::OFFICE_COLUMNS[0]),
+    ("bbox6d", thesis::OFFICE_COLUMNS[1]),
+    ("trimesh", thesis::OFFICE_COLUMNS[2]),
+    ("rapier", thesis::OFFICE_COLUMNS[3]),
     ("pointcloud", "–"),
 ];
 /// The matrix's planners, the thesis's five first, with their labels.
-const PLANNERS: [(&str, &str); 9] = [
+const PLANNERS: [(&str, &str); 10] = [
     ("rrt", "RRT"),
     ("ma-rrt", "MA RRT"),
     ("evasion-rrt", "Ev. RRT"),
@@ -40,23 +47,7 @@ const PLANNERS: [(&str, &str); 9] = [
     ("prm-star", "PRM*"),
     ("lazy-prm", "lazy PRM"),
     ("rrt-star", "RRT*"),
-];
-
-/// Thesis Table 5.3, median wall time in s (L6154–6166): Simple, BB6D, OPCODE, Bullet.
-const THESIS_5_3: [(&str, [Option<f64>; 4]); 5] = [
-    ("rrt", [Some(0.010057), Some(0.006137), Some(0.002435), Some(0.004721)]),
-    ("ma-rrt", [Some(0.124055), Some(0.060409), None, Some(0.055298)]),
-    ("evasion-rrt", [Some(0.18627), Some(0.156209), None, Some(0.099351)]),
-    ("prm", [Some(0.013578), Some(0.010544), Some(0.001309), Some(0.008801)]),
-    ("ma-prm", [Some(1.96683), Some(1.20087), None, Some(0.678831)]),
-];
-/// Thesis Table 5.5, median added path length in m (L6220–6232).
-const THESIS_5_5: [(&str, [Option<f64>; 4]); 5] = [
-    ("rrt", [Some(23.1608), Some(23.1608), Some(21.5803), Some(23.1608)]),
-    ("ma-rrt", [Some(22.166), Some(22.3942), None, Some(22.1411)]),
-    ("evasion-rrt", [Some(25.7439), Some(26.621), None, Some(26.621)]),
-    ("prm", [Some(41.3277), Some(41.3277), Some(40.2935), Some(41.3277)]),
-    ("ma-prm", [Some(66.0655), Some(64.6227), None, Some(68.2961)]),
+    ("prm-valid", "PRM (valid samples)"),
 ];
 
 /// Linear interpolation between closest ranks (type 7); `None` for no values.
@@ -74,14 +65,15 @@ pub fn quantile(values: &[f64], p: f64) -> Option<f64> {
 /// The runs of one cell: seed → metric → value.
 pub type Runs = BTreeMap<u64, BTreeMap<String, f64>>;
 
-/// The matrix rows of one revision, reduced to per-case metrics.
+/// The matrix rows of each scene's last revision, reduced to per-case metrics.
 #[derive(Debug, Default)]
 pub struct Matrix {
     /// (scene, backend, planner) → seed → metric → value.
     pub cells: BTreeMap<(String, String, String), Runs>,
     /// The rows used.
     pub rows: usize,
-    /// The git revision, and whether any row came from a modified tree.
+    /// The git revision of the last matrix row, and whether any row used came from a modified
+    /// tree.
     pub revision: String,
     pub dirty: bool,
     /// Distinct hosts, CPUs, rustc versions, worker counts, commands; first and last date.
@@ -90,11 +82,15 @@ pub struct Matrix {
     pub rustc: BTreeSet<String>,
     pub jobs: BTreeSet<u64>,
     pub commands: BTreeSet<String>,
+    /// The commands per scene.
+    pub scene_commands: BTreeMap<String, BTreeSet<String>>,
     pub dates: (String, String),
+    /// Per scene, the git revision whose rows are used.
+    pub scene_revisions: BTreeMap<String, String>,
 }
 
 impl Matrix {
-    /// The rows of bench `roadmap` of the last such row's revision.
+    /// The rows of bench `roadmap`, per scene those of the revision of its last row.
     pub fn from_rows(rows: &[Value]) -> Matrix {
         let rev = |r: &Value| {
             r.pointer("/provenance/git_revision").and_then(Value::as_str).unwrap_or("").to_owned()
@@ -103,11 +99,13 @@ impl Matrix {
             .iter()
             .filter(|r| r.get("bench").and_then(Value::as_str) == Some("roadmap"))
             .collect();
+        let scene = |r: &Value| r.get("scene").and_then(Value::as_str).unwrap_or("").to_owned();
         let mut m = Matrix {
             revision: ours.last().map(|r| rev(r)).unwrap_or_default(),
+            scene_revisions: ours.iter().map(|r| (scene(r), rev(r))).collect(),
             ..Matrix::default()
         };
-        for r in ours.into_iter().filter(|r| rev(r) == m.revision) {
+        for r in ours.into_iter().filter(|r| m.scene_revisions.get(&scene(r)) == Some(&rev(r))) {
             let s = |k: &str| r.get(k).and_then(Value::as_str).map(str::to_owned);
             let p = |k: &str| {
                 r.pointer(&format!("/provenance/{k}")).and_then(Value::as_str).map(str::to_owned)
@@ -122,6 +120,7 @@ impl Matrix {
             ) else {
                 continue;
             };
+            m.scene_commands.entry(scene.clone()).or_default().extend(s("command"));
             m.cells
                 .entry((scene, backend, planner))
                 .or_default()
@@ -190,160 +189,6 @@ fn sig3(x: f64) -> String {
     format!("{x:.decimals$}")
 }
 
-/// One cell "ours / thesis (×ratio)".
-fn cell(ours: Option<f64>, thesis: Option<f64>, fmt: fn(f64) -> String) -> String {
-    match (ours, thesis) {
-        (None, _) => "–".into(),
-        (Some(o), None) => fmt(o),
-        (Some(o), Some(t)) => format!("{} / {} (×{})", fmt(o), fmt(t), sig3(o / t)),
-    }
-}
-
-/// A table of the office: planners × backends, cells "ours / thesis (×ratio)".
-fn office_table(
-    m: &Matrix,
-    metric: &str,
-    thesis: &[(&str, [Option<f64>; 4])],
-    fmt: fn(f64) -> String,
-) -> String {
-    let mut out = String::from("| planner |");
-    let mut rule = String::from("|---|");
-    for (b, t) in BACKENDS {
-        if t == "–" {
-            let _ = write!(out, " {b} |");
-        } else {
-            let _ = write!(out, " {b} ({t}) |");
-        }
-        rule.push_str("---|");
-    }
-    out.push_str(" solved |\n");
-    out.push_str(&rule);
-    out.push_str("---|\n");
-    for (p, label) in PLANNERS {
-        if !BACKENDS.iter().any(|(b, _)| m.solved("office", b, p).is_some()) {
-            continue;
-        }
-        let _ = write!(out, "| {label} |");
-        let mut solved = Vec::new();
-        for (i, (b, _)) in BACKENDS.iter().enumerate() {
-            let t = thesis.iter().find(|r| r.0 == p).and_then(|r| r.1.get(i).copied().flatten());
-            let ours = quantile(&m.values("office", b, p, metric), 0.5);
-            let _ = write!(
-                out,
-                " {} |",
-                if m.solved("office", b, p).is_some() { cell(ours, t, fmt) } else { "–".into() }
-            );
-            solved.push(m.solved("office", b, p).map_or("–".into(), |(s, n)| format!("{s}/{n}")));
-        }
-        let _ = writeln!(out, " {} |", solved.join(" "));
-    }
-    out
-}
-
-/// The plot: median office time per planner (groups) and backend (bars) on a log axis, the
-/// thesis's Table 5.3 as black ticks on the bars of its four columns.
-pub fn office_time_svg(m: &Matrix) -> String {
-    let planners: Vec<(&str, &str)> = PLANNERS
-        .iter()
-        .copied()
-        .filter(|(p, _)| BACKENDS.iter().any(|(b, _)| m.solved("office", b, p).is_some()))
-        .collect();
-    let colours = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#9c755f"];
-    let mut values = Vec::new();
-    for (p, _) in &planners {
-        for (b, _) in BACKENDS {
-            values.extend(quantile(&m.values("office", b, p, "time"), 0.5));
-        }
-    }
-    values.extend(THESIS_5_3.iter().flat_map(|r| r.1.iter().flatten().copied()));
-    let positive: Vec<f64> = values.into_iter().filter(|v| *v > 0.0).collect();
-    let lo = positive.iter().copied().fold(f64::INFINITY, f64::min).log10().floor().min(-3.0);
-    let hi =
-        positive.iter().copied().fold(f64::NEG_INFINITY, f64::max).log10().ceil().max(lo + 1.0);
-    let (w, h, left, top, bottom) = (960.0, 440.0, 70.0, 40.0, 90.0);
-    let plot_h = h - top - bottom;
-    let group = (w - left - 20.0) / planners.len().max(1) as f64;
-    let bar = group * 0.8 / BACKENDS.len() as f64;
-    let y = |v: f64| top + plot_h * (hi - v.log10()) / (hi - lo);
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{}" y="20" text-anchor="middle" font-size="14">Office (thesis §5.5.3): median time to reach the four ROIs, log scale; black ticks: thesis Table 5.3</text>"#,
-        w / 2.0
-    );
-    let mut d = lo;
-    while d <= hi + 1e-9 {
-        let yy = y(10f64.powf(d));
-        let _ = writeln!(
-            s,
-            r##"<line x1="{left}" y1="{yy:.1}" x2="{}" y2="{yy:.1}" stroke="#ddd"/>"##,
-            w - 20.0
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{}" y="{:.1}" text-anchor="end">{}</text>"#,
-            left - 6.0,
-            yy + 4.0,
-            time_text(10f64.powf(d))
-        );
-        d += 1.0;
-    }
-    for (g, (p, label)) in planners.iter().enumerate() {
-        let x0 = left + g as f64 * group + group * 0.1;
-        for (i, (b, _)) in BACKENDS.iter().enumerate() {
-            let x = x0 + i as f64 * bar;
-            if let Some(v) = quantile(&m.values("office", b, p, "time"), 0.5).filter(|v| *v > 0.0) {
-                let yy = y(v);
-                let _ = writeln!(
-                    s,
-                    r#"<rect x="{x:.1}" y="{yy:.1}" width="{:.1}" height="{:.1}" fill="{}"><title>{label} on {b}: {}</title></rect>"#,
-                    bar * 0.9,
-                    (top + plot_h - yy).max(0.0),
-                    colours[i],
-                    time_text(v)
-                );
-            }
-            let thesis =
-                THESIS_5_3.iter().find(|r| r.0 == *p).and_then(|r| r.1.get(i).copied().flatten());
-            if let Some(t) = thesis {
-                let yy = y(t);
-                let _ = writeln!(
-                    s,
-                    r#"<line x1="{x:.1}" y1="{yy:.1}" x2="{:.1}" y2="{yy:.1}" stroke="black" stroke-width="3"><title>thesis {label} on {}: {}</title></line>"#,
-                    x + bar * 0.9,
-                    BACKENDS[i].1,
-                    time_text(t)
-                );
-            }
-        }
-        let _ = writeln!(
-            s,
-            r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{label}</text>"#,
-            left + g as f64 * group + group / 2.0,
-            top + plot_h + 18.0
-        );
-    }
-    for (i, (b, t)) in BACKENDS.iter().enumerate() {
-        let x = left + i as f64 * 170.0;
-        let yy = h - 30.0;
-        let name = if *t == "–" { b.to_string() } else { format!("{b} ({t})") };
-        let _ = writeln!(
-            s,
-            r#"<rect x="{x}" y="{}" width="12" height="12" fill="{}"/>"#,
-            yy - 10.0,
-            colours[i]
-        );
-        let _ = writeln!(s, r#"<text x="{}" y="{yy}">{name}</text>"#, x + 16.0);
-    }
-    s.push_str("</svg>\n");
-    s
-}
-
 /// The page.
 pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
     if m.rows == 0 {
@@ -367,12 +212,18 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
     writeln!(o, "## Provenance\n")?;
     writeln!(o, "| | |\n|---|---|")?;
     writeln!(o, "| rows | {} ({} cells, up to {} seeds each) |", m.rows, m.cells.len(), m.seeds())?;
-    writeln!(
-        o,
-        "| git revision | `{}`{} |",
-        m.revision,
-        if m.dirty { " (modified tree)" } else { "" }
-    )?;
+    let mut scenes_of: BTreeMap<&String, Vec<&str>> = BTreeMap::new();
+    for (scene, rev) in &m.scene_revisions {
+        scenes_of.entry(rev).or_default().push(scene);
+    }
+    let revision = if scenes_of.len() <= 1 {
+        format!("`{}`", m.revision)
+    } else {
+        let per_rev: Vec<String> =
+            scenes_of.iter().map(|(r, s)| format!("`{r}` ({})", s.join(", "))).collect();
+        per_rev.join("; ")
+    };
+    writeln!(o, "| git revision | {revision}{} |", if m.dirty { " (modified tree)" } else { "" })?;
     writeln!(o, "| host, CPU | {}; {} |", list(&m.hosts), list(&m.cpus))?;
     writeln!(o, "| rustc | {} |", list(&m.rustc))?;
     writeln!(o, "| dates | {} – {} |", m.dates.0, m.dates.1)?;
@@ -384,27 +235,8 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
         m.commands.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ")
     )?;
 
-    writeln!(o, "## Office: Table 5.3, median time to reach the four ROIs (thesis §5.5.3)\n")?;
-    writeln!(
-        o,
-        "The shared floor plan (20 × 15 × 2.5 m), robot radius 0.3 m, step 1 m, one growing tree or \
-         roadmap from the centre to the four corner rooms, at most 100,000 iterations. Cells: ours \
-         / thesis (×ours/thesis); the thesis's columns are Simple, BB6D, OPCODE and Bullet, in the \
-         roles of our polygon, bbox6d, trimesh and rapier maps. `solved`: runs that reached all four \
-         ROIs per backend.\n\nCommand: `cargo xtask bench roadmap --scene office` (the thesis's 50 \
-         runs: `--seeds 50`), then `cargo xtask docs`.\n"
-    )?;
-    o.push_str(&office_table(m, "time", &THESIS_5_3, time_text));
-    writeln!(o, "\n![median office time per planner and backend]({svg_name})\n")?;
-    writeln!(o, "## Office: Table 5.5, median added length of the paths to the ROIs\n")?;
-    writeln!(
-        o,
-        "The sum of the four paths' lengths, start to each ROI (a shared prefix counted per path). \
-         Our floor plan is the shared benchmark's, not the thesis's (whose dimensions are lost), so \
-         lengths compare relatively.\n\nCommand: as Table 5.3 (the same runs).\n"
-    )?;
-    o.push_str(&office_table(m, "path_length", &THESIS_5_5, |x| format!("{} m", sig3(x))));
-    writeln!(o, "\n## Lab: RRT time per map (thesis §6.1, Fig 6.4)\n")?;
+    o.push_str(&office_sections(m, svg_name));
+    writeln!(o, "## Lab: RRT time per map (thesis §6.1, Fig 6.4)\n")?;
     writeln!(
         o,
         "The simulated lab's exact geometry (planar patches plus the tessellated barrel, ball and \
@@ -429,6 +261,11 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
              an order of magnitude slower\" (L6784–6785; > 4 s against < 0.4 s, so > ×10).",
             sig3(pc / patch)
         )?;
+    }
+    let scans = lab_scans_section(m);
+    if !scans.is_empty() {
+        o.push('\n');
+        o.push_str(&scans);
     }
     Ok(o)
 }
@@ -522,12 +359,32 @@ mod tests {
             "path length median 55 m against 23.1608 m"
         );
         assert!(page.contains("1.00 ms (1.00 ms–1.00 ms) / thesis < 0.4 s (×0.00250)"), "{page}");
-        assert!(page.contains("`new`") && !page.contains("100 s"));
+        assert!(page.contains("| git revision | `new` |") && !page.contains("100 s"), "{page}");
         assert!(page.contains("fastest patch map (polygon): ours ×50.0"), "{page}");
         let svg = office_time_svg(&m);
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("RRT on rapier: 4.50 ms"));
         assert!(page_of_nothing_fails());
+    }
+
+    #[test]
+    fn each_scene_uses_the_rows_of_its_own_last_revision() {
+        let rows = vec![
+            row("office", "rapier", "rrt", 0, "time", 0.1, "a"),
+            row("office", "rapier", "rrt", 0, "solved", 1.0, "a"),
+            row("lab", "polygon", "rrt", 0, "time_k500", 9.0, "a"),
+            row("office", "rapier", "rrt", 0, "time", 0.004, "b"),
+            row("office", "rapier", "rrt", 0, "solved", 1.0, "b"),
+            row("lab", "polygon", "rrt", 0, "time_k500", 0.002, "c"),
+            row("lab", "polygon", "rrt", 0, "solved", 0.0, "c"),
+        ];
+        let m = Matrix::from_rows(&rows);
+        assert_eq!(m.revision, "c");
+        assert_eq!(m.rows, 4, "office from b, lab from c");
+        let page = page(&m, "x.svg").unwrap();
+        assert!(page.contains("4.00 ms / 4.72 ms"), "{page}");
+        assert!(page.contains("2.00 ms (2.00 ms–2.00 ms) / thesis < 0.4 s"), "{page}");
+        assert!(page.contains("| git revision | `b` (office); `c` (lab) |"), "{page}");
     }
 
     fn page_of_nothing_fails() -> bool {
@@ -540,7 +397,127 @@ mod tests {
         assert_eq!(time_text(1.96683), "1.97 s");
         assert_eq!(time_text(0.000147), "147 µs");
         assert_eq!(sig3(23.1608), "23.2");
-        assert_eq!(cell(None, Some(1.0), sig3), "–");
-        assert_eq!(cell(Some(2.0), None, sig3), "2.00");
+        assert_eq!(office::cell(None, Some(1.0), sig3), "–");
+        assert_eq!(office::cell(Some(2.0), None, sig3), "2.00");
+        assert_eq!(office::cell(Some(2.0), Some(0.0), sig3), "2.00 / 0 (×–)");
+    }
+
+    /// Five solved office runs of RRT on rapier (the thesis's Bullet column) with known
+    /// quartiles, an unsolved one that must not count, and one run of a planner the thesis
+    /// does not have; `metrics` picks which metrics the rows carry.
+    fn office_rows(metrics: &[&str]) -> Vec<Value> {
+        let mut rows = Vec::new();
+        for seed in 0..5u64 {
+            let i = seed as f64;
+            let values = [
+                ("time", 0.001 * (i + 1.0)),
+                ("path_length", 20.0 + 2.0 * i),
+                ("steep_turns", [2.0, 3.0, 3.0, 4.0, 5.0][seed as usize]),
+                ("turns", 16.0 + 2.0 * i),
+                ("curviness", [72.0, 76.0, 80.0, 88.0, 90.0][seed as usize]),
+            ];
+            for (metric, value) in values.into_iter().filter(|(m, _)| metrics.contains(m)) {
+                rows.push(row("office", "rapier", "rrt", seed, metric, value, "r"));
+            }
+            rows.push(row("office", "rapier", "rrt", seed, "solved", 1.0, "r"));
+        }
+        rows.push(row("office", "rapier", "rrt", 5, "time", 50.0, "r"));
+        rows.push(row("office", "rapier", "rrt", 5, "turns", 500.0, "r"));
+        rows.push(row("office", "rapier", "rrt", 5, "solved", 0.0, "r"));
+        rows.push(row("office", "rapier", "prm-valid", 0, "time", 0.01, "r"));
+        rows.push(row("office", "rapier", "prm-valid", 0, "solved", 1.0, "r"));
+        rows
+    }
+
+    /// The line of the table under heading `table` ("5.4") of the planner `label`.
+    fn table_line<'a>(page: &'a str, table: &str, label: &str) -> &'a str {
+        let start = page.find(&format!("### Table {table}:")).expect("the table's heading");
+        let section = &page[start..];
+        let end = section[4..].find("\n#").map_or(section.len(), |e| e + 4);
+        section[..end]
+            .lines()
+            .find(|l| l.starts_with(&format!("| {label} |")))
+            .unwrap_or_else(|| panic!("no row {label} in Table {table}: {section}"))
+    }
+
+    #[test]
+    fn every_office_table_puts_the_thesis_beside_ours() {
+        let all = ["time", "path_length", "steep_turns", "turns", "curviness"];
+        let m = Matrix::from_rows(&office_rows(&all));
+        let page = page(&m, "img/x.svg").unwrap();
+        // The columns: polygon, bbox6d, trimesh, rapier (Bullet), pointcloud, solved.
+        let bullet = |table: &str| {
+            let line = table_line(&page, table, "RRT");
+            line.split(" | ").nth(4).unwrap().to_owned()
+        };
+        // Table 5.3: median 3 ms against the thesis's Bullet RRT 4.721 ms.
+        assert_eq!(bullet("5.3"), "3.00 ms / 4.72 ms (×0.635)");
+        // Table 5.4: quartiles 2 and 4 ms over the median 3 ms, against .570/1.730.
+        assert_eq!(bullet("5.4"), "0.667/1.333 / 0.570/1.730 (×1.17/×0.771)");
+        // Table 5.5: median 24 m against 23.1608 m; 5.6: 22/24 and 26/24 against .904/1.060.
+        assert_eq!(bullet("5.5"), "24.0 m / 23.2 m (×1.04)");
+        assert_eq!(bullet("5.6"), "0.917/1.083 / 0.904/1.060 (×1.01/×1.02)");
+        // Tables 5.7–5.9: steep turns 3, 3, 4 and turns 18, 20, 22 at the quartiles.
+        assert_eq!(bullet("5.7"), "3/20/0.150 / 3/20/0.150 (×1.00/×1.00/×1.00)");
+        assert_eq!(bullet("5.8"), "3/18/0.167 / 2/17/0.118 (×1.50/×1.06/×1.41)");
+        assert_eq!(bullet("5.9"), "4/22/0.182 / 4/22/0.182 (×1.00/×1.00/×0.999)");
+        // Tables 5.10, 5.11: median 80° against 78.0185°; 76/80 and 88/80 against .850/1.093.
+        assert_eq!(bullet("5.10"), "80.0° / 78.0° (×1.03)");
+        assert_eq!(bullet("5.11"), "0.950/1.100 / 0.850/1.093 (×1.12/×1.01)");
+        for table in ["5.3", "5.4", "5.5", "5.6", "5.7", "5.8", "5.9", "5.10", "5.11"] {
+            let line = table_line(&page, table, "RRT");
+            assert!(line.ends_with("| – – – 5/6 – |"), "Table {table}: {line}");
+            // A planner the thesis does not have: ours alone.
+            let ours = table_line(&page, table, "PRM (valid samples)");
+            assert!(!ours.contains(" / ") && !ours.contains('×'), "Table {table}: {ours}");
+        }
+        assert!(table_line(&page, "5.3", "PRM (valid samples)").contains("| 10.0 ms |"));
+        // Each table explains itself and names the command that made the rows.
+        assert_eq!(page.matches("\nMeasures ").count(), 9, "{page}");
+        assert_eq!(page.matches("Command: `cargo xtask bench roadmap` (the thesis's").count(), 9);
+        assert!(page.contains("(L6154–6166)") && page.contains("(L6386–6402)"), "{page}");
+        assert!(page.contains("Simple 28/50, BB6D 28/50, Bullet 30/50"), "{page}");
+        assert!(!page.contains("Not reproduced"), "{page}");
+    }
+
+    #[test]
+    fn a_table_whose_metric_the_rows_lack_says_so() {
+        let m = Matrix::from_rows(&office_rows(&["time", "path_length"]));
+        let page = page(&m, "img/x.svg").unwrap();
+        assert_eq!(bullet_of(&page, "5.3"), "3.00 ms / 4.72 ms (×0.635)");
+        assert_eq!(bullet_of(&page, "5.6"), "0.917/1.083 / 0.904/1.060 (×1.01/×1.02)");
+        // The unsolved run's turns must not count as the metric being there.
+        let lacks = |metrics: &str| page.matches(&format!("carry no {metrics} metric")).count();
+        assert_eq!(lacks("`steep_turns`, `turns`"), 3, "Tables 5.7–5.9: {page}");
+        assert_eq!(lacks("`curviness`"), 2, "Tables 5.10, 5.11: {page}");
+        assert_eq!(page.matches("Not reproduced").count(), 5);
+        // No office rows at all: one note instead of the tables, the lab section still there.
+        let lab = vec![
+            row("lab", "polygon", "rrt", 0, "time_k500", 0.001, "r"),
+            row("lab", "polygon", "rrt", 0, "solved", 0.0, "r"),
+        ];
+        let page = super::page(&Matrix::from_rows(&lab), "x.svg").unwrap();
+        assert!(page.contains("hold no run of scene `office`"), "{page}");
+        assert!(!page.contains("### Table") && page.contains("## Lab"), "{page}");
+    }
+
+    fn bullet_of(page: &str, table: &str) -> String {
+        table_line(page, table, "RRT").split(" | ").nth(4).unwrap().to_owned()
+    }
+
+    #[test]
+    fn the_lists_follow_the_thesis_and_the_planner_names() {
+        // The thesis's five planners first, in its row order.
+        let first: Vec<Option<roadmap::PlannerKind>> =
+            PLANNERS[..5].iter().map(|(p, _)| p.parse().ok()).collect();
+        let rows: Vec<Option<roadmap::PlannerKind>> =
+            thesis::TABLE_5_3.rows.iter().map(|r| Some(r.planner)).collect();
+        assert_eq!(first, rows);
+        // Every planner of the crate has a row.
+        for kind in roadmap::PlannerKind::ALL {
+            assert!(PLANNERS.iter().any(|(p, _)| *p == kind.name()), "{kind} has no row");
+        }
+        let columns: Vec<&str> = BACKENDS[..4].iter().map(|b| b.1).collect();
+        assert_eq!(columns, thesis::OFFICE_COLUMNS);
     }
 }

@@ -3,11 +3,13 @@
 //! cylinder caps as regular polygons) and every curved surface (sphere, cylinder side) as one
 //! tessellated trimesh patch — the `hybrid` map of the thesis's Table 6.1 as a perfect patch
 //! extraction would give it, built by [`scene_sim::patches`] (as `patchnav`'s lab map builder
-//! does for `--source scene`).
+//! does for `--source scene`); and the corner start shared with the maps built from scans
+//! ([`super::lab_maps`]).
 
 use anyhow::{Context, Result};
 use patch_core::{CapsuleStep, Patch, Point3, Real, UnspecificStepIntersector as _};
 use patch_map::AnyMap;
+use pointcloud::Aabb;
 use scene_sim::Scene;
 use scene_sim::patches::Tessellation;
 
@@ -20,10 +22,19 @@ pub(crate) fn scene_patches(scene: &Scene) -> Result<Vec<Patch>> {
 }
 
 /// The start of the lab's RRTs (thesis §6.1: "room corners"): the first point free on every map
-/// on a small spiral from 0.6 m inside the south-west corner, at 1.0 m height.
-pub(crate) fn corner_start(maps: &[&AnyMap], radius: Real) -> Result<Point3> {
+/// (and inside `within`, when given) on a small spiral from 0.6 m inside the south-west corner,
+/// at 1.0 m height — the first of `patchnav experiment lab-timing`'s four corner starts, by the
+/// same rule.
+pub(crate) fn corner_start(
+    maps: &[&AnyMap],
+    radius: Real,
+    within: Option<&Aabb>,
+) -> Result<Point3> {
     let free = |p: &Point3| {
-        maps.iter().all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.is_step_free(&s)))
+        within.is_none_or(|b| b.contains(p))
+            && maps
+                .iter()
+                .all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.is_step_free(&s)))
     };
     (0..8)
         .flat_map(|ring| {

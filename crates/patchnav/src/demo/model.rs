@@ -224,6 +224,16 @@ pub struct TimingCurve {
 /// Explored volume.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct VolumeSection {
+    /// The planner whose roadmaps were rasterised (`rrt`: Table 6.2, `prm`: Table 6.4; empty
+    /// in results written before it was recorded).
+    #[serde(default)]
+    pub planner: String,
+    /// Runs per map (starts × seeds).
+    #[serde(default)]
+    pub runs: usize,
+    /// Iterations of every run (K).
+    #[serde(default)]
+    pub iterations: u64,
     /// Cell edge, metres.
     pub cell: f64,
     /// Map types, in table order.
@@ -243,6 +253,25 @@ pub struct VolumeSection {
     /// Per cell of the slice (row-major, row 0 at the smallest y) a bit per map type (bit i =
     /// map i explored it).
     pub slice_bits: Vec<u8>,
+}
+
+impl VolumeSection {
+    /// The largest finite percentage of the table with its row and column map: (% of the
+    /// row map's explored volume, row map, column map).
+    pub fn largest_difference(&self) -> Option<(f64, &str, &str)> {
+        let mut largest: Option<(f64, &str, &str)> = None;
+        for (i, row) in self.table.iter().enumerate() {
+            for (j, cell) in row.iter().enumerate() {
+                if let (Some(x), Some(a), Some(b)) = (cell, self.maps.get(i), self.maps.get(j))
+                    && x.is_finite()
+                    && largest.is_none_or(|l| *x > l.0)
+                {
+                    largest = Some((*x, a, b));
+                }
+            }
+        }
+        largest
+    }
 }
 
 /// A file the demo wrote.

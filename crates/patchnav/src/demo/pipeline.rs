@@ -31,6 +31,7 @@
 //!   a goal only by a sample within the tolerance, often misses: such runs are reported
 //!   unsolved, with the paths to the goals they reached.
 
+pub(crate) mod explore;
 pub(crate) mod maps;
 pub(crate) mod planning;
 mod sensors;

@@ -30,24 +30,6 @@ pub const SECTIONS: [&str; 9] = [
     "9. Files",
 ];
 
-/// Thesis Table 6.1 (lab dataset): map, file size, planar patches, trimesh patches, point
-/// clouds, triangles.
-const THESIS_TABLE_6_1: [[&str; 6]; 4] = [
-    ["hybrid", "8.7 MB", "5,906", "4,142", DASH, "345,533"],
-    ["pc", "54.0 MB", DASH, DASH, "29", DASH],
-    ["planes", "3.0 MB", "5,906", "0", DASH, "86,174"],
-    ["trimesh", "106.4 MB", "0", "17,273", DASH, "5,600,612"],
-];
-
-/// Thesis Table 6.2 (RRT, lab): map, explored volume [m³], then % not in planes, hybrid,
-/// trimesh, pc.
-const THESIS_TABLE_6_2: [[&str; 6]; 4] = [
-    ["planes", "9,714.015", DASH, "0.557", "1.739", "0.986"],
-    ["hybrid", "9,693.171", "0.343", DASH, "1.551", "0.803"],
-    ["trimesh", "9,564.215", "0.200", "0.223", DASH, "0.347"],
-    ["pc", "9,651.058", "0.340", "0.370", "1.244", DASH],
-];
-
 /// Width pictures are shown at, pixels.
 const PICTURE_WIDTH: u32 = 800;
 
@@ -270,8 +252,20 @@ fn section_maps(r: &DemoResults) -> String {
         ));
     }
     out.push_str("</div>\n<div><h3>Thesis Table 6.1 (Lab)</h3>\n");
-    let rows: Vec<Vec<String>> =
-        THESIS_TABLE_6_1.iter().map(|r| r.iter().map(|c| (*c).to_owned()).collect()).collect();
+    let count = |n: Option<u32>| n.map_or(DASH.to_owned(), int);
+    let rows: Vec<Vec<String>> = roadmap::thesis::TABLE_6_1
+        .iter()
+        .map(|r| {
+            vec![
+                r.map.to_owned(),
+                format!("{:.1} MB", r.file_size_mb),
+                count(r.planar_patches),
+                count(r.trimesh_patches),
+                count(r.point_clouds),
+                count(r.triangles),
+            ]
+        })
+        .collect();
     out.push_str(&table(
         &["map", "file size", "planar patches", "trimesh patches", "point clouds", "triangles"],
         &rows,
@@ -458,23 +452,12 @@ fn map_pictures(r: &DemoResults, d: &MapDrawing) -> String {
 /// Section 5: explored volume (Table 6.2, Fig 6.1).
 fn section_volume(vol: Option<&VolumeSection>) -> String {
     let mut out = String::new();
-    let mut largest: Option<(f64, &str, &str)> = None;
-    if let Some(v) = vol {
-        for (i, row) in v.table.iter().enumerate() {
-            for (j, cell) in row.iter().enumerate() {
-                if let (Some(x), Some(a), Some(b)) = (cell, v.maps.get(i), v.maps.get(j))
-                    && x.is_finite()
-                    && largest.is_none_or(|l| *x > l.0)
-                {
-                    largest = Some((*x, a, b));
-                }
-            }
-        }
-    }
+    let largest = vol.and_then(VolumeSection::largest_difference);
     let ours = match (vol, largest) {
         (Some(v), Some((x, a, b))) => format!(
-            " Here, on cells of {} m, the largest difference is {} % of the {a} map's explored volume \
-             not explored on the {b} map.",
+            " Here{}, on cells of {} m, the largest difference is {} % of the {a} map's explored \
+             volume not explored on the {b} map.",
+            runs_text(v),
             sig(v.cell, 3),
             sig(x, 3)
         ),
@@ -517,9 +500,20 @@ fn section_volume(vol: Option<&VolumeSection>) -> String {
         let header_refs: Vec<&str> = headers.iter().map(String::as_str).collect();
         out.push_str(&table(&header_refs, &rows));
     }
-    out.push_str("</div>\n<div><h3>Thesis Table 6.2 (RRT, Lab)</h3>\n");
-    let rows: Vec<Vec<String>> =
-        THESIS_TABLE_6_2.iter().map(|r| r.iter().map(|c| (*c).to_owned()).collect()).collect();
+    let (thesis, title) = if v.planner == "prm" {
+        (&roadmap::thesis::TABLE_6_4_PRM, "Thesis Table 6.4 (PRM, Lab)")
+    } else {
+        (&roadmap::thesis::TABLE_6_2_RRT, "Thesis Table 6.2 (RRT, Lab)")
+    };
+    let _ = write!(out, "</div>\n<div><h3>{title}</h3>\n");
+    let rows: Vec<Vec<String>> = thesis
+        .iter()
+        .map(|r| {
+            let mut row = vec![r.map.to_owned(), fixed(r.volume_m3, 3)];
+            row.extend(r.not_in_percent.iter().map(|c| c.map_or(DASH.to_owned(), |p| fixed(p, 3))));
+            row
+        })
+        .collect();
     out.push_str(&table(
         &["map", "volume [m³]", "not in planes", "not in hybrid", "not in trimesh", "not in pc"],
         &rows,
@@ -573,6 +567,21 @@ fn section_volume(vol: Option<&VolumeSection>) -> String {
         }
     }
     out
+}
+
+/// What the volume's roadmaps were (` (RRT, 8 runs per map of 3,000 iterations)`), empty
+/// when the results do not say.
+fn runs_text(v: &VolumeSection) -> String {
+    if v.planner.is_empty() || v.runs == 0 {
+        return String::new();
+    }
+    format!(
+        " ({}, {} run{} per map of {} iterations)",
+        esc(&v.planner.to_uppercase()),
+        int(v.runs as u64),
+        if v.runs == 1 { "" } else { "s" },
+        int(v.iterations)
+    )
 }
 
 /// Section 6: time against iterations (Fig 6.4).
@@ -945,6 +954,9 @@ mod tests {
                 })
                 .collect(),
             volume: Some(VolumeSection {
+                planner: "rrt".into(),
+                runs: 8,
+                iterations: 1000,
                 cell: 0.1,
                 maps: maps.iter().map(|s| (*s).into()).collect(),
                 volumes_m3: vec![400.0, 399.0, 395.5, 401.2],

@@ -55,6 +55,7 @@ use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
 use patch_map::AnyMap;
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
+use roadmap::thesis;
 use roadmap::volume::{CongruenceTable, VoxelGrid};
 use roadmap::{
     MaxIterations, Planner as _, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Roadmap,
@@ -152,32 +153,6 @@ pub struct LabVolumeArgs {
     #[arg(long, default_value_t = 320, value_parser = clap::value_parser!(u32).range(1..=65_536))]
     pub cells: u32,
 }
-
-/// The thesis's Table 6.1 (Lab, L6721–6739): file size, planar patches, trimesh patches,
-/// point clouds, triangles.
-const THESIS_TABLE_6_1: [(&str, &str, &str, &str, &str, &str); 4] = [
-    ("planes", "3.0 MB", "5906", "0", "–", "86,174"),
-    ("hybrid", "8.7 MB", "5906", "4142", "–", "345,533"),
-    ("trimesh", "106.4 MB", "0", "17,273", "–", "5,600,612"),
-    ("pc", "54.0 MB", "–", "–", "29", "–"),
-];
-
-/// The thesis's Table 6.2 (RRT, Lab, L6760–6772): volume (m³) and % not in planes, hybrid,
-/// trimesh, pc.
-const THESIS_TABLE_6_2_RRT: [(&str, f64, [Option<f64>; 4]); 4] = [
-    ("planes", 9714.015, [None, Some(0.557), Some(1.739), Some(0.986)]),
-    ("hybrid", 9693.171, [Some(0.343), None, Some(1.551), Some(0.803)]),
-    ("trimesh", 9564.215, [Some(0.200), Some(0.223), None, Some(0.347)]),
-    ("pc", 9651.058, [Some(0.340), Some(0.370), Some(1.244), None]),
-];
-
-/// The thesis's Table 6.4 (PRM, Lab, L7068–7080).
-const THESIS_TABLE_6_4_PRM: [(&str, f64, [Option<f64>; 4]); 4] = [
-    ("planes", 11859.6544, [None, Some(0.160), Some(0.737), Some(0.387)]),
-    ("hybrid", 11841.7095, [Some(0.008), None, Some(0.593), Some(0.251)]),
-    ("trimesh", 11776.3023, [Some(0.035), Some(0.041), None, Some(0.056)]),
-    ("pc", 11818.7659, [Some(0.042), Some(0.057), Some(0.416), None]),
-];
 
 /// The thesis's timing claims for Fig 6.4 (L6784–6818).
 const THESIS_FIG_6_4: &str = "thesis Fig 6.4 (Lab, i7 920, Bullet / Alg. 10): at K = 500 \
@@ -318,8 +293,17 @@ fn table_6_1(lab: &Lab, args: &LabMapArgs) -> Result<String> {
         "| Map | file size | planar patches | trimesh patches | point clouds | triangles |"
     )?;
     writeln!(out, "|---|---|---|---|---|---|")?;
-    for (m, size, planar, trimesh, clouds, tris) in THESIS_TABLE_6_1 {
-        writeln!(out, "| {m} | {size} | {planar} | {trimesh} | {clouds} | {tris} |")?;
+    for r in thesis::TABLE_6_1 {
+        writeln!(
+            out,
+            "| {} | {:.1} MB | {} | {} | {} | {} |",
+            r.map,
+            r.file_size_mb,
+            thesis_count(r.planar_patches),
+            thesis_count(r.trimesh_patches),
+            thesis_count(r.point_clouds),
+            thesis_count(r.triangles)
+        )?;
     }
     let find = |k: MapKind| lab.maps.iter().find(|m| m.kind == k).map(BuiltMap::memory_bytes);
     if let (Some(planes), Some(pc)) = (find(MapKind::Planes), find(MapKind::Pc)) {
@@ -751,7 +735,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     )?;
     write!(out, "{rrt}")?;
     writeln!(out, "thesis Table 6.2 (RRT, Lab, 480 RRTs per map, K = 10,000, 1024³ × 38.684 mm):")?;
-    write!(out, "{}", thesis_volume_table(&THESIS_TABLE_6_2_RRT))?;
+    write!(out, "{}", thesis_volume_table(&thesis::TABLE_6_2_RRT))?;
     writeln!(
         out,
         "\nTable 6.4 analogue: PRM explored volume [m³] and % not in, {} seeds, K = {prm_k}",
@@ -759,7 +743,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     )?;
     write!(out, "{prm}")?;
     writeln!(out, "thesis Table 6.4 (PRM, Lab):")?;
-    write!(out, "{}", thesis_volume_table(&THESIS_TABLE_6_4_PRM))?;
+    write!(out, "{}", thesis_volume_table(&thesis::TABLE_6_4_PRM))?;
     writeln!(
         out,
         "\nThe thesis's volumes are of its own maps' boxes (objects seen through windows \
@@ -770,13 +754,34 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-fn thesis_volume_table(rows: &[(&str, f64, [Option<f64>; 4])]) -> String {
-    let mut out = String::from("| Map | Volume [m³] | planes | hybrid | trimesh | pc |\n");
+/// A count of Table 6.1: "–" for none, thousands separated from 10,000 on ("5906", "17,273").
+fn thesis_count(n: Option<u32>) -> String {
+    let Some(n) = n else { return "–".to_owned() };
+    if n < 10_000 {
+        return n.to_string();
+    }
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A thesis table of explored volumes (Tables 6.2, 6.4) as a Markdown table.
+fn thesis_volume_table(rows: &[thesis::VolumeRow]) -> String {
+    let mut out = format!("| Map | Volume [m³] | {} |\n", thesis::LAB_MAPS.join(" | "));
     out.push_str("|---|---|---|---|---|---|\n");
-    for (name, volume, cells) in rows {
-        let cells: Vec<String> =
-            cells.iter().map(|c| c.map_or("–".to_owned(), |p| format!("{p:.3}"))).collect();
-        let _ = writeln!(out, "| {name} | {volume} | {} |", cells.join(" | "));
+    for r in rows {
+        let cells: Vec<String> = r
+            .not_in_percent
+            .iter()
+            .map(|c| c.map_or("–".to_owned(), |p| format!("{p:.3}")))
+            .collect();
+        let _ = writeln!(out, "| {} | {} | {} |", r.map, r.volume_m3, cells.join(" | "));
     }
     out
 }
@@ -812,6 +817,18 @@ mod tests {
         assert!(!t.should_stop(&p(3, 6)));
         assert!(t.should_stop(&p(4, 9)));
         assert_eq!(t.seconds, vec![0.005, 0.009]);
+    }
+
+    #[test]
+    fn thesis_tables_print_as_the_thesis_prints_them() {
+        assert_eq!(thesis_count(Some(5906)), "5906");
+        assert_eq!(thesis_count(Some(5_600_612)), "5,600,612");
+        assert_eq!(thesis_count(None), "–");
+        let rrt = thesis_volume_table(&thesis::TABLE_6_2_RRT);
+        assert!(rrt.starts_with("| Map | Volume [m³] | planes | hybrid | trimesh | pc |"), "{rrt}");
+        assert!(rrt.contains("| planes | 9714.015 | – | 0.557 | 1.739 | 0.986 |"), "{rrt}");
+        let prm = thesis_volume_table(&thesis::TABLE_6_4_PRM);
+        assert!(prm.contains("| hybrid | 11841.7095 | 0.008 | – | 0.593 | 0.251 |"), "{prm}");
     }
 
     #[test]

@@ -31,6 +31,10 @@
 //! the quantile of steep turns over the quantile of total turns, as the thesis's numbers show
 //! (3/20 = .150, 22/91 = .242); 0 where there are no turns at all.
 //!
+//! # The thesis's figures
+//! Printed beside ours from [`roadmap::thesis`] (Tables 5.3–5.11 with their line references),
+//! the one copy of them in the workspace.
+//!
 //! # Caps
 //! The thesis found the MA PRM's number of vertices by binary search (L6123–6141); here every
 //! planner gets the same iteration cap (`--max-iterations`, 100,000 by default) and a run that
@@ -48,7 +52,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{Point3, Real};
 use roadmap::metrics::{added_length, quantile, turn_angles, upper_quartile};
-use roadmap::{PathMetrics, Planner};
+use roadmap::thesis::{self, OFFICE_COLUMNS, OfficeTable, QuartileRatios, Turns};
+use roadmap::{PathMetrics, Planner, PlannerKind};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -112,81 +117,6 @@ const BACKENDS: &[(ProblemBackend, &str, &str)] = &[
     (ProblemBackend::Trimesh, "trimesh", "OPCODE"),
     (ProblemBackend::Rapier, "rapier", "Bullet"),
     (ProblemBackend::Pointcloud, "pointcloud", "–"),
-];
-
-/// The thesis's planners (the row labels of its tables).
-const THESIS_PLANNERS: [&str; 5] = ["RRT", "MA RRT", "Ev. RRT", "PRM", "MA PRM"];
-/// The thesis's columns.
-const THESIS_BACKENDS: [&str; 4] = ["Simple", "BB6D", "OPCODE", "Bullet"];
-
-type ThesisTable = &'static [(&'static str, [&'static str; 4])];
-
-/// Thesis Table 5.3, median wall time in s (L6154–6166).
-const THESIS_5_3: ThesisTable = &[
-    ("RRT", [".010057", ".006137", ".002435", ".004721"]),
-    ("MA RRT", [".124055", ".060409", "–", ".055298"]),
-    ("Ev. RRT", [".18627", ".156209", "–", ".099351"]),
-    ("PRM", [".013578", ".010544", ".001309", ".008801"]),
-    ("MA PRM", ["1.96683", "1.20087", "–", ".678831"]),
-];
-/// Thesis Table 5.4, time quartiles / median (L6168–6180).
-const THESIS_5_4: ThesisTable = &[
-    ("RRT", [".547/1.874", ".570/1.837", ".716/1.544", ".570/1.730"]),
-    ("MA RRT", [".513/1.484", ".550/1.643", "–", ".520/1.545"]),
-    ("Ev. RRT", [".339/2.141", ".305/1.909", "–", ".337/2.124"]),
-    ("PRM", [".525/2.621", ".520/2.830", ".770/1.388", ".452/3.123"]),
-    ("MA PRM", [".253/1.307", ".239/1.243", "–", ".354/1.558"]),
-];
-/// Thesis Table 5.5, median added path length in m (L6220–6232).
-const THESIS_5_5: ThesisTable = &[
-    ("RRT", ["23.1608", "23.1608", "21.5803", "23.1608"]),
-    ("MA RRT", ["22.166", "22.3942", "–", "22.1411"]),
-    ("Ev. RRT", ["25.7439", "26.621", "–", "26.621"]),
-    ("PRM", ["41.3277", "41.3277", "40.2935", "41.3277"]),
-    ("MA PRM", ["66.0655", "64.6227", "–", "68.2961"]),
-];
-/// Thesis Table 5.6, added-length quartiles / median (L6239–6253).
-const THESIS_5_6: ThesisTable = &[
-    ("RRT", [".904/1.060", ".904/1.060", ".926/1.158", ".904/1.060"]),
-    ("MA RRT", [".947/1.042", ".935/1.034", "–", ".943/1.047"]),
-    ("Ev. RRT", [".923/1.104", ".932/1.066", "–", ".924/1.066"]),
-    ("PRM", [".838/1.212", ".838/1.212", ".843/1.291", ".838/1.212"]),
-    ("MA PRM", [".797/1.094", ".815/1.167", "–", ".771/1.158"]),
-];
-/// Thesis Tables 5.7 (median), 5.8 (lower quartile), 5.9 (upper quartile): steep turns /
-/// total turns / ratio (L6255–6342).
-const THESIS_5_7_TO_9: ThesisTable = &[
-    ("RRT, median", ["3/20/.150", "3/20/.150", "2/18/.111", "3/20/.150"]),
-    ("RRT, lower", ["2/17/.118", "2/17/.118", "1/16/.062", "2/17/.118"]),
-    ("RRT, upper", ["4/22/.182", "4/22/.182", "3/21/.143", "4/22/.182"]),
-    ("MA RRT, median", ["3/18/.167", "3/18/.167", "–", "2/18/.111"]),
-    ("MA RRT, lower", ["2/17/.118", "1/17/.059", "–", "2/17/.118"]),
-    ("MA RRT, upper", ["4/20/.200", "4/20/.200", "–", "4/20/.200"]),
-    ("Ev. RRT, median", ["3/23/.130", "3/24/.125", "–", "3/24/.125"]),
-    ("Ev. RRT, lower", ["2/21/.095", "2/22/.091", "–", "2/22/.091"]),
-    ("Ev. RRT, upper", ["5/25/.200", "5/25/.200", "–", "5/25/.200"]),
-    ("PRM, median", ["7/14/.500", "7/14/.500", "4/8/.500", "7/14/.500"]),
-    ("PRM, lower", ["4/9/.444", "4/9/.444", "3/5/.600", "4/9/.444"]),
-    ("PRM, upper", ["9/18/.500", "9/18/.500", "7/11/.636", "9/18/.500"]),
-    ("MA PRM, median", ["36/160/.225", "36/167/.216", "–", "38/189/.201"]),
-    ("MA PRM, lower", ["22/91/.242", "22/95/.232", "–", "24/95/.253"]),
-    ("MA PRM, upper", ["46/242/.190", "48/242/.198", "–", "52/238/.218"]),
-];
-/// Thesis Table 5.10, median curviness [°] (L6344–6358).
-const THESIS_5_10: ThesisTable = &[
-    ("RRT", ["78.0185", "78.0185", "71.383", "78.0185"]),
-    ("MA RRT", ["78.5776", "77.6607", "–", "78.8892"]),
-    ("Ev. RRT", ["80.0567", "78.5778", "–", "77.8766"]),
-    ("PRM", ["119.903", "119.903", "135.332", "119.903"]),
-    ("MA PRM", ["86.8547", "86.8317", "–", "86.5707"]),
-];
-/// Thesis Table 5.11, curviness quartiles / median (L6386–6400).
-const THESIS_5_11: ThesisTable = &[
-    ("RRT", [".850/1.093", ".850/1.093", ".858/1.153", ".850/1.093"]),
-    ("MA RRT", [".791/1.048", ".838/1.060", "–", ".832/1.065"]),
-    ("Ev. RRT", [".913/1.042", ".937/1.060", "–", ".946/1.063"]),
-    ("PRM", [".876/1.080", ".876/1.080", ".905/1.158", ".876/1.080"]),
-    ("MA PRM", [".973/1.028", ".968/1.029", "–", ".960/1.042"]),
 ];
 
 /// The metrics of one successful run (see the [module docs](self)).
@@ -297,68 +227,123 @@ fn metric(runs: &[RunMetrics], f: fn(&RunMetrics) -> Real) -> Vec<Real> {
     runs.iter().map(f).collect()
 }
 
-/// A row variant of a table: its label suffix and how a cell is printed from the successful
-/// runs (`None`: no successful run).
+/// How a cell of a row variant of a table is printed from the successful runs (`None`: no
+/// successful run).
 type CellFormat = fn(&[RunMetrics]) -> Option<String>;
 
-/// One printed table: ours, then the thesis's.
+/// How the thesis's cell of a planner and column (an index into [`OFFICE_COLUMNS`]) is
+/// printed, as the thesis prints it (`None`: its "–").
+type ThesisCell = fn(PlannerKind, usize) -> Option<String>;
+
+/// One printed table: ours, then the thesis's (from [`roadmap::thesis`]).
 struct TableSpec {
     id: &'static str,
     caption: &'static str,
-    rows: &'static [(&'static str, CellFormat)],
-    thesis: ThesisTable,
+    /// The row variants: label suffix, our cell, the thesis's cell.
+    rows: &'static [(&'static str, CellFormat, ThesisCell)],
+}
+
+fn thesis_quartiles(q: QuartileRatios) -> String {
+    format!("{}/{}", ratio(q.lower), ratio(q.upper))
+}
+
+fn thesis_turns(t: Turns) -> String {
+    format!("{}/{}/{}", t.steep, t.total, ratio(t.ratio))
 }
 
 const TABLES: &[TableSpec] = &[
     TableSpec {
         id: "5.3",
         caption: "median wall time [s] to reach the ROIs",
-        rows: &[("", |r| quantile(&metric(r, |m| m.time_s), 0.5).map(thesis_number))],
-        thesis: THESIS_5_3,
+        rows: &[(
+            "",
+            |r| quantile(&metric(r, |m| m.time_s), 0.5).map(thesis_number),
+            |p, c| thesis::TABLE_5_3.cell(p, c).map(thesis_number),
+        )],
     },
     TableSpec {
         id: "5.4",
         caption: "lower/upper quartile of wall time, as factors of the median",
-        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.time_s)))],
-        thesis: THESIS_5_4,
+        rows: &[(
+            "",
+            |r| quartile_ratios(&metric(r, |m| m.time_s)),
+            |p, c| thesis::TABLE_5_4.cell(p, c).map(thesis_quartiles),
+        )],
     },
     TableSpec {
         id: "5.5",
         caption: "median added length [m] of the paths from the start to all ROIs",
-        rows: &[("", |r| quantile(&metric(r, |m| m.length), 0.5).map(thesis_number))],
-        thesis: THESIS_5_5,
+        rows: &[(
+            "",
+            |r| quantile(&metric(r, |m| m.length), 0.5).map(thesis_number),
+            |p, c| thesis::TABLE_5_5.cell(p, c).map(thesis_number),
+        )],
     },
     TableSpec {
         id: "5.6",
         caption: "lower/upper quartile of added length, as factors of the median",
-        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.length)))],
-        thesis: THESIS_5_6,
+        rows: &[(
+            "",
+            |r| quartile_ratios(&metric(r, |m| m.length)),
+            |p, c| thesis::TABLE_5_6.cell(p, c).map(thesis_quartiles),
+        )],
     },
     TableSpec {
         id: "5.7–5.9",
         caption: "steep (> 90°) / total turns / ratio on the paths to the ROIs: median, lower \
                   and upper quartile",
         rows: &[
-            (", median", |r| turns_at(r, 0.5)),
-            (", lower", |r| turns_at(r, 0.25)),
-            (", upper", |r| turns_at(r, 0.75)),
+            (
+                ", median",
+                |r| turns_at(r, 0.5),
+                |p, c| thesis::TABLE_5_7.cell(p, c).map(thesis_turns),
+            ),
+            (
+                ", lower",
+                |r| turns_at(r, 0.25),
+                |p, c| thesis::TABLE_5_8.cell(p, c).map(thesis_turns),
+            ),
+            (
+                ", upper",
+                |r| turns_at(r, 0.75),
+                |p, c| thesis::TABLE_5_9.cell(p, c).map(thesis_turns),
+            ),
         ],
-        thesis: THESIS_5_7_TO_9,
     },
     TableSpec {
         id: "5.10",
         caption: "median curviness [°] (upper quartile of the turn angles on the paths to the \
                   ROIs)",
-        rows: &[("", |r| quantile(&metric(r, |m| m.curviness_deg), 0.5).map(thesis_number))],
-        thesis: THESIS_5_10,
+        rows: &[(
+            "",
+            |r| quantile(&metric(r, |m| m.curviness_deg), 0.5).map(thesis_number),
+            |p, c| thesis::TABLE_5_10.cell(p, c).map(thesis_number),
+        )],
     },
     TableSpec {
         id: "5.11",
         caption: "lower/upper quartile of curviness, as factors of the median",
-        rows: &[("", |r| quartile_ratios(&metric(r, |m| m.curviness_deg)))],
-        thesis: THESIS_5_11,
+        rows: &[(
+            "",
+            |r| quartile_ratios(&metric(r, |m| m.curviness_deg)),
+            |p, c| thesis::TABLE_5_11.cell(p, c).map(thesis_quartiles),
+        )],
     },
 ];
+
+/// The thesis's table of `spec`, laid out as the thesis prints it.
+fn thesis_table(spec: &TableSpec) -> String {
+    let mut rows =
+        vec![std::iter::once("").chain(OFFICE_COLUMNS).map(str::to_owned).collect::<Vec<_>>()];
+    for (row, &choice) in FIVE.iter().enumerate() {
+        for (suffix, _, cell) in spec.rows {
+            let mut line = vec![format!("{}{suffix}", thesis_label(row))];
+            line.extend((0..4).map(|c| cell(choice.kind(), c).unwrap_or_else(|| "–".to_owned())));
+            rows.push(line);
+        }
+    }
+    layout(&rows)
+}
 
 /// Lays out rows of cells in columns: the first left-aligned, the others right-aligned.
 fn layout(rows: &[Vec<String>]) -> String {
@@ -463,7 +448,7 @@ impl Results<'_> {
         );
         let mut rows = vec![header];
         for i in self.shown_planners() {
-            for (suffix, format) in spec.rows {
+            for (suffix, format, _) in spec.rows {
                 let mut row = vec![format!("{}{suffix}", self.planners[i].label)];
                 row.extend(self.cells[i].iter().map(|c| match c {
                     Cell::Cannot(_) => "–".to_owned(),
@@ -475,14 +460,7 @@ impl Results<'_> {
         out.push_str(&layout(&rows));
         writeln!(out, "{}", self.successes_line())?;
         writeln!(out, "Table {} (thesis): {}", spec.id, spec.caption)?;
-        let mut rows =
-            vec![std::iter::once("").chain(THESIS_BACKENDS).map(str::to_owned).collect()];
-        for (label, cells) in spec.thesis {
-            rows.push(
-                std::iter::once(*label).chain(cells.iter().copied()).map(str::to_owned).collect(),
-            );
-        }
-        out.push_str(&layout(&rows));
+        out.push_str(&thesis_table(spec));
         writeln!(out)?;
         Ok(())
     }
@@ -644,11 +622,16 @@ fn backend_name(backend: ProblemBackend) -> &'static str {
     BACKENDS.iter().find(|b| b.0 == backend).map_or("?", |b| b.1)
 }
 
-/// A thesis table's number at planner `row` (index into [`FIVE`]) and column `col` (index into
-/// [`FOUR`]); `part` picks the `part`-th of "a/b/c". `None` for "–".
-fn thesis_value(table: ThesisTable, row: usize, col: usize, part: usize) -> Option<Real> {
-    let cell = table[row].1[col];
-    cell.split('/').nth(part)?.parse().ok()
+/// The thesis's figure of `table` at planner `row` (index into [`FIVE`]) and column `col`
+/// (index into [`FOUR`] and [`OFFICE_COLUMNS`]); `None` for "–".
+fn thesis_value<T: Copy>(table: &OfficeTable<T>, row: usize, col: usize) -> Option<T> {
+    table.cell(FIVE[row].kind(), col)
+}
+
+/// The thesis's label of planner `row` (index into [`FIVE`]).
+fn thesis_label(row: usize) -> &'static str {
+    let kind = FIVE[row].kind();
+    thesis::TABLE_5_3.rows.iter().find(|r| r.planner == kind).map_or("?", |r| r.label)
 }
 
 /// One column of values for the claims: per planner of [`FIVE`], `Some(value)` where known.
@@ -680,7 +663,7 @@ fn per_column(
     let thesis_parts: Vec<String> = (0..4)
         .filter_map(|c| {
             let col: Column = std::array::from_fn(|r| thesis(r, c));
-            check(&col).map(|s| format!("{} {s}", THESIS_BACKENDS[c]))
+            check(&col).map(|s| format!("{} {s}", OFFICE_COLUMNS[c]))
         })
         .collect();
     let our_parts: Vec<String> = results
@@ -707,7 +690,7 @@ fn claims(r: &Results<'_>) -> String {
     let time = |m: &RunMetrics| m.time_s;
     let length = |m: &RunMetrics| m.length;
     let curv = |m: &RunMetrics| m.curviness_deg;
-    let t_time = |row, col| thesis_value(THESIS_5_3, row, col, 0);
+    let t_time = |row, col| thesis_value(&thesis::TABLE_5_3, row, col);
 
     claim(
         &mut out,
@@ -722,11 +705,11 @@ fn claims(r: &Results<'_>) -> String {
                 rest[fastest] = None;
                 let second = argmin(&rest);
                 let ok = fastest == 0 && second == Some(3);
-                let second = second.map_or("–", |i| THESIS_PLANNERS[i]);
+                let second = second.map_or("–", thesis_label);
                 Some(if ok {
                     "yes".to_owned()
                 } else {
-                    format!("no ({} fastest, {second} second)", THESIS_PLANNERS[fastest])
+                    format!("no ({} fastest, {second} second)", thesis_label(fastest))
                 })
             },
         ),
@@ -751,7 +734,8 @@ fn claims(r: &Results<'_>) -> String {
         // Naive (Simple, BB6D) over Bullet, per planner: worst and best factor.
         let factors = |value: &dyn Fn(usize, usize) -> Option<Real>, names: [&str; 2]| {
             let mut all: Vec<(Real, String)> = Vec::new();
-            for (row, name) in THESIS_PLANNERS.iter().enumerate() {
+            for row in 0..FIVE.len() {
+                let name = thesis_label(row);
                 for (c, col_name) in names.iter().enumerate() {
                     if let (Some(naive), Some(bullet)) = (value(row, c), value(row, 3)) {
                         all.push((naive / bullet, format!("{col_name}/{name}")));
@@ -784,8 +768,8 @@ fn claims(r: &Results<'_>) -> String {
         );
     }
     {
-        let thesis = thesis_value(THESIS_5_3, 3, 2, 0)
-            .zip(thesis_value(THESIS_5_3, 3, 3, 0))
+        let thesis = thesis_value(&thesis::TABLE_5_3, 3, 2)
+            .zip(thesis_value(&thesis::TABLE_5_3, 3, 3))
             .map(|(o, b)| format!("OPCODE/Bullet PRM time {:.2}: {}", o / b, yes(o > b)));
         let ours = r
             .median(P::Prm, B::Trimesh, time)
@@ -800,9 +784,8 @@ fn claims(r: &Results<'_>) -> String {
     {
         // Time spread (upper − lower)/median.
         let spread = |q: [Real; 3]| (q[2] - q[0]) / q[1];
-        let t_spread = |row, col| {
-            Some(thesis_value(THESIS_5_4, row, col, 1)? - thesis_value(THESIS_5_4, row, col, 0)?)
-        };
+        let t_spread =
+            |row, col| thesis_value(&thesis::TABLE_5_4, row, col).map(|q| q.upper - q.lower);
         claim(
             &mut out,
             "PRM has the largest variance of time (L6204–6205, Table 5.4): largest (upper − \
@@ -816,13 +799,13 @@ fn claims(r: &Results<'_>) -> String {
                     Some(if i == 3 {
                         "yes".to_owned()
                     } else {
-                        format!("no ({})", THESIS_PLANNERS[i])
+                        format!("no ({})", thesis_label(i))
                     })
                 },
             ),
         );
-        let t_up = |row, col| thesis_value(THESIS_5_4, row, col, 1);
-        let t_lo = |row, col| thesis_value(THESIS_5_4, row, col, 0);
+        let t_up = |row, col| thesis_value(&thesis::TABLE_5_4, row, col).map(|q| q.upper);
+        let t_lo = |row, col| thesis_value(&thesis::TABLE_5_4, row, col).map(|q| q.lower);
         claim(
             &mut out,
             "MA PRM shows the smallest upward variance (L6205–6206): smallest upper/median",
@@ -835,7 +818,7 @@ fn claims(r: &Results<'_>) -> String {
                     Some(if i == 4 {
                         "yes".to_owned()
                     } else {
-                        format!("no ({})", THESIS_PLANNERS[i])
+                        format!("no ({})", thesis_label(i))
                     })
                 },
             ),
@@ -852,7 +835,7 @@ fn claims(r: &Results<'_>) -> String {
                     Some(if i == 4 {
                         "yes".to_owned()
                     } else {
-                        format!("no ({})", THESIS_PLANNERS[i])
+                        format!("no ({})", thesis_label(i))
                     })
                 },
             ),
@@ -881,12 +864,12 @@ fn claims(r: &Results<'_>) -> String {
             "Among the frameworks OPCODE is the most stable, Bullet and Simple vary most \
              (L6207–6208): mean (upper − lower)/median of RRT and PRM time",
             (
-                mean_spread(&t_spread, &THESIS_BACKENDS),
+                mean_spread(&t_spread, &OFFICE_COLUMNS),
                 mean_spread(&ours, &["polygon", "bbox6d", "trimesh", "rapier"]),
             ),
         );
     }
-    let t_len = |row, col| thesis_value(THESIS_5_5, row, col, 0);
+    let t_len = |row, col| thesis_value(&thesis::TABLE_5_5, row, col);
     claim(
         &mut out,
         "MA RRT produces the shortest paths, RRT's only marginally longer (L6214–6215, Table \
@@ -900,7 +883,7 @@ fn claims(r: &Results<'_>) -> String {
                 let factor = col[0].zip(col[1]).map(|(a, b)| format!(", RRT/MA RRT {:.3}", a / b));
                 Some(format!(
                     "{}{}",
-                    if i == 1 { "yes".to_owned() } else { format!("no ({})", THESIS_PLANNERS[i]) },
+                    if i == 1 { "yes".to_owned() } else { format!("no ({})", thesis_label(i)) },
                     factor.unwrap_or_default()
                 ))
             },
@@ -925,7 +908,7 @@ fn claims(r: &Results<'_>) -> String {
         let s = r.median(p, b, |m| m.steep)?;
         Some(steep_ratio(s, r.median(p, b, |m| m.turns)?))
     };
-    let t_ratio = |row, col| thesis_value(THESIS_5_7_TO_9, 3 * row, col, 2);
+    let t_ratio = |row, col| thesis_value(&thesis::TABLE_5_7, row, col).map(|t| t.ratio);
     claim(
         &mut out,
         "PRM's paths have few turns, but 50% of them steep (L6282–6283, Table 5.7): PRM's \
@@ -950,10 +933,10 @@ fn claims(r: &Results<'_>) -> String {
         "Evasion RRT creates the smoothest paths (L6301): lowest median steep/total ratio",
         per_column(r, our_ratio, t_ratio, |col| {
             let i = argmin(col)?;
-            Some(if i == 2 { "yes".to_owned() } else { format!("no ({})", THESIS_PLANNERS[i]) })
+            Some(if i == 2 { "yes".to_owned() } else { format!("no ({})", thesis_label(i)) })
         }),
     );
-    let t_curv = |row, col| thesis_value(THESIS_5_10, row, col, 0);
+    let t_curv = |row, col| thesis_value(&thesis::TABLE_5_10, row, col);
     claim(
         &mut out,
         "Curviness: the RRT-based planners similar, MA PRM trails, PRM worst by far (L6361–6363, \
@@ -989,18 +972,17 @@ fn claims(r: &Results<'_>) -> String {
                 _ => String::new(),
             }
         };
-        let mut thesis = Vec::new();
+        let mut theirs = Vec::new();
         let mut ours = Vec::new();
-        for (row, name) in THESIS_PLANNERS.iter().enumerate() {
-            for (c, col) in THESIS_BACKENDS.iter().enumerate() {
-                if let (Some(lo), Some(up)) =
-                    (thesis_value(THESIS_5_11, row, c, 0), thesis_value(THESIS_5_11, row, c, 1))
-                {
-                    thesis.push((lo, up, format!("{name}/{col}")));
+        for (row, &planner) in FIVE.iter().enumerate() {
+            let name = thesis_label(row);
+            for (c, col) in OFFICE_COLUMNS.iter().enumerate() {
+                if let Some(q) = thesis_value(&thesis::TABLE_5_11, row, c) {
+                    theirs.push((q.lower, q.upper, format!("{name}/{col}")));
                 }
             }
             for b in &r.backends {
-                if let Some(q) = r.quartiles(FIVE[row], b.0, curv) {
+                if let Some(q) = r.quartiles(planner, b.0, curv) {
                     ours.push((q[0] / q[1], q[2] / q[1], format!("{name}/{}", b.1)));
                 }
             }
@@ -1009,7 +991,7 @@ fn claims(r: &Results<'_>) -> String {
             &mut out,
             "Curviness varies little: lower quartile below 83% of the median only once (.791, \
              MA RRT/Simple), upper above 110% only on OPCODE (L6367–6371, Table 5.11)",
-            (extremes(thesis), extremes(ours)),
+            (extremes(theirs), extremes(ours)),
         );
     }
     claim(
@@ -1021,8 +1003,8 @@ fn claims(r: &Results<'_>) -> String {
                 .map(|row| {
                     let col: Column =
                         std::array::from_fn(|c| (c < 4).then(|| t_time(row, c)).flatten());
-                    let best = argmin(&col).map_or("–", |c| THESIS_BACKENDS[c]);
-                    format!("{} {best}", THESIS_PLANNERS[row])
+                    let best = argmin(&col).map_or("–", |c| OFFICE_COLUMNS[c]);
+                    format!("{} {best}", thesis_label(row))
                 })
                 .collect();
             let ours: Vec<String> = FIVE
@@ -1099,10 +1081,20 @@ fn claims(r: &Results<'_>) -> String {
             "MA PRM reached all ROIs in 28 of 50 runs (Simple, BB6D, OPCODE) and 30 (Bullet) \
              (L6141–6145; §7.15: OPCODE cannot run MA PRM); ours with one iteration cap, no \
              binary search",
-            ("Simple 28/50, BB6D 28/50, Bullet 30/50".to_owned(), ours.join(", ")),
+            (thesis_ma_prm_solved(), ours.join(", ")),
         );
     }
     out
+}
+
+/// The thesis's MA PRM successes out of 50 in the columns that can run it ("Simple 28/50, ...").
+fn thesis_ma_prm_solved() -> String {
+    let ma_prm = FIVE.iter().position(|&p| p == P::MaPrm).unwrap_or(4);
+    (0..4)
+        .filter(|&c| thesis_value(&thesis::TABLE_5_3, ma_prm, c).is_some())
+        .map(|c| format!("{} {}/50", OFFICE_COLUMNS[c], thesis::MA_PRM_SOLVED_OF_50[c]))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
@@ -1123,21 +1115,35 @@ mod tests {
     }
 
     #[test]
-    fn thesis_tables_parse_and_have_the_thesis_rows() {
-        for table in [THESIS_5_3, THESIS_5_4, THESIS_5_5, THESIS_5_6, THESIS_5_10, THESIS_5_11] {
-            let labels: Vec<&str> = table.iter().map(|r| r.0).collect();
-            assert_eq!(labels, THESIS_PLANNERS);
+    fn thesis_tables_print_as_the_thesis_prints_them() {
+        let text: Vec<String> = TABLES.iter().map(thesis_table).collect();
+        // Table 5.3, first and last rows (L6156, L6164).
+        assert!(text[0].contains("RRT      .010057  .006137  .002435  .004721"), "{}", text[0]);
+        assert!(text[0].contains("MA PRM   1.96683  1.20087        –  .678831"), "{}", text[0]);
+        // Table 5.4 (L6176) and Tables 5.7–5.9 (L6257, L6313, L6336), the thesis's ratio digits.
+        assert!(text[1].contains(".525/2.621  .520/2.830  .770/1.388  .452/3.123"), "{}", text[1]);
+        assert!(text[4].contains("RRT, median"), "{}", text[4]);
+        for needle in ["3/20/.150", "22/91/.242", "46/242/.190", "3/5/.600", "1/16/.062"] {
+            assert!(text[4].contains(needle), "{needle}: {}", text[4]);
         }
-        assert_eq!(THESIS_5_7_TO_9.len(), 15);
-        // The thesis's own ratios check out (3/20 = .150).
-        assert_eq!(thesis_value(THESIS_5_7_TO_9, 0, 0, 2), Some(0.15));
-        assert_eq!(thesis_value(THESIS_5_3, 1, 2, 0), None);
-        // §7.15: the worst naive/Bullet factor is 2.90, not 2.35.
-        let f =
-            thesis_value(THESIS_5_3, 4, 0, 0).unwrap() / thesis_value(THESIS_5_3, 4, 3, 0).unwrap();
-        assert!((f - 2.897).abs() < 1e-3);
+        assert!(text[5].contains("119.903") && text[5].contains("71.383"), "{}", text[5]);
+        // One line per thesis row (plus the header): 5 per table, 15 for Tables 5.7–5.9.
+        let lines: Vec<usize> = text.iter().map(|t| t.lines().count()).collect();
+        assert_eq!(lines, [6, 6, 6, 6, 16, 6, 6]);
+        assert_eq!(thesis_ma_prm_solved(), "Simple 28/50, BB6D 28/50, Bullet 30/50");
+    }
+
+    #[test]
+    fn the_thesis_rows_come_first_in_its_order() {
         // Every planner of the thesis has a row, in the thesis's order, before ours.
-        let first: Vec<&str> = PLANNERS.iter().take(5).map(|r| r.label).collect();
-        assert_eq!(first, THESIS_PLANNERS);
+        let first: Vec<PlannerKind> = PLANNERS.iter().take(5).map(|r| r.choice.kind()).collect();
+        let thesis: Vec<PlannerKind> = thesis::TABLE_5_3.rows.iter().map(|r| r.planner).collect();
+        assert_eq!(first, thesis);
+        assert_eq!(FIVE.map(PlannerChoice::kind).to_vec(), thesis);
+        let labels: Vec<&str> = PLANNERS.iter().take(5).map(|r| r.label).collect();
+        assert_eq!(labels, (0..5).map(thesis_label).collect::<Vec<_>>());
+        // The claims read the thesis through the planner: MA RRT has no OPCODE figure.
+        assert_eq!(thesis_value(&thesis::TABLE_5_3, 1, 2), None);
+        assert_eq!(thesis_value(&thesis::TABLE_5_7, 3, 0).map(|t| t.ratio), Some(0.5));
     }
 }

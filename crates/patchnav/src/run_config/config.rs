@@ -2,9 +2,12 @@
 //! checked, paths resolved against the file's folder (the keys and their defaults are in the
 //! parent module's documentation).
 
+use crate::demo::model::Scale;
+use crate::demo::pipeline::Settings;
+use crate::demo::pipeline::explore::{ExplorePlanner, MAX_VOLUME_MAPS};
 use crate::extract::SensorPreset;
 use crate::plan::PlannerChoice;
-use crate::scene_map::{MapKind, PatchBackend};
+use crate::scene_map::{MapKind, PatchBackend, Tessellation};
 use crate::terrain::AxesChoice;
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
@@ -27,6 +30,18 @@ pub const MAX_ITERATIONS_LIMIT: u64 = 100_000_000;
 pub const DEFAULT_SPACING: Real = 0.05;
 /// Output folder, relative to the configuration file's folder.
 pub const DEFAULT_OUT: &str = "out/run";
+/// Largest accepted `maps.max_patch_triangles`.
+pub const MAX_PATCH_TRIANGLES_LIMIT: u64 = 1_000_000;
+/// Largest accepted `timing.checkpoints` (as `patchnav experiment lab-timing --checkpoints`).
+pub const MAX_CHECKPOINTS: u64 = 10_000;
+/// Largest accepted `volume.cells` (the thesis's grid: 1024 cells of 38.684 mm, §6.1.1).
+pub const MAX_CELLS: u64 = 1024;
+
+/// The demo's default scale, whose timing and volume settings are the defaults of `[timing]`
+/// and `[volume]`.
+fn demo_settings() -> Settings {
+    Settings::of(Scale::Default)
+}
 
 /// The file as written.
 #[derive(Debug, Deserialize)]
@@ -38,6 +53,8 @@ struct RawConfig {
     plan: RawPlan,
     tof: Option<RawTof>,
     terrain: Option<RawTerrain>,
+    timing: Option<RawTiming>,
+    volume: Option<RawVolume>,
     #[serde(default)]
     output: RawOutput,
 }
@@ -61,6 +78,8 @@ struct RawMaps {
     backends: Option<Vec<String>>,
     sensor: Option<String>,
     spacing: Option<Real>,
+    mesh_edge: Option<Real>,
+    max_patch_triangles: Option<i64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -98,6 +117,25 @@ struct RawTerrain {
     axes: Option<String>,
     max_range: Option<f64>,
     sectors: Option<usize>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTiming {
+    iterations: Option<i64>,
+    checkpoints: Option<i64>,
+    seeds: Option<Vec<u64>>,
+    starts: Option<Vec<[Real; 3]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawVolume {
+    planner: Option<String>,
+    iterations: Option<i64>,
+    seeds: Option<Vec<u64>>,
+    starts: Option<Vec<[Real; 3]>>,
+    cells: Option<i64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -184,6 +222,45 @@ pub struct TerrainConfig {
     pub sectors: usize,
 }
 
+/// RRTs timed against iterations (`[timing]`, thesis Fig 6.4).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimingConfig {
+    /// Iterations of every run (K).
+    pub iterations: u64,
+    /// Checkpoints per run (about; 100, 500 and 1000 are added below K).
+    pub checkpoints: u64,
+    /// Seeds, each run from every start.
+    pub seeds: Vec<u64>,
+    /// Starts.
+    pub starts: Vec<Point3>,
+}
+
+/// Explored volume compared across the maps (`[volume]`, thesis Table 6.2 / 6.4, Fig 6.1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VolumeConfig {
+    /// The planner grown.
+    pub planner: ExplorePlanner,
+    /// Iterations of every run.
+    pub iterations: u64,
+    /// Seeds, each run from every start.
+    pub seeds: Vec<u64>,
+    /// Starts; the slice picture lies at the first one's height.
+    pub starts: Vec<Point3>,
+    /// Voxels per axis of the grid covering every map.
+    pub cells: u32,
+}
+
+impl VolumeConfig {
+    /// Whether the volume comes from the very runs `timing` makes (same planner, iterations,
+    /// seeds and starts), as in the demo.
+    pub fn shares_runs_with(&self, timing: &TimingConfig) -> bool {
+        self.planner == ExplorePlanner::Rrt
+            && self.iterations == timing.iterations
+            && self.seeds == timing.seeds
+            && self.starts == timing.starts
+    }
+}
+
 /// A checked configuration, paths resolved.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
@@ -201,12 +278,21 @@ pub struct Config {
     pub sensor: SensorPreset,
     /// Sample spacing of a mesh's `pc` map, metres.
     pub spacing: Real,
+    /// A mesh's trimesh map: longest triangle edge, metres (`None`: the surfaces' own
+    /// triangles, unsplit).
+    pub mesh_edge: Option<Real>,
+    /// A mesh's trimesh map: most triangles per trimesh patch.
+    pub max_patch_triangles: usize,
     /// Planning.
     pub plan: PlanConfig,
     /// ToF frame.
     pub tof: Option<TofConfig>,
     /// Terrain frame.
     pub terrain: Option<TerrainConfig>,
+    /// RRT timing.
+    pub timing: Option<TimingConfig>,
+    /// Explored volume.
+    pub volume: Option<VolumeConfig>,
     /// Output folder.
     pub out: PathBuf,
     /// Write the 3D files.
@@ -217,7 +303,7 @@ pub struct Config {
 pub fn allowed_types(input: &Input) -> &'static [MapKind] {
     match input {
         Input::Scans { .. } => &MapKind::ALL,
-        Input::Mesh(_) => &[MapKind::Planes, MapKind::Hybrid, MapKind::Pc],
+        Input::Mesh(_) => &MapKind::ALL,
         // A map file holds one type, known once it is read.
         Input::Map(_) => &MapKind::ALL,
         Input::Cloud(_) => &[MapKind::Pc],
@@ -259,6 +345,43 @@ fn positive(key: &str, v: Real) -> Result<Real> {
     Ok(v)
 }
 
+/// An integer in `1..=max`, or an error naming `key`.
+fn count(key: &str, v: i64, max: u64) -> Result<u64> {
+    match u64::try_from(v) {
+        Ok(n @ 1..) if n <= max => Ok(n),
+        _ => bail!("{key} must be in 1..={max}, not {v}"),
+    }
+}
+
+/// Seeds: at least one, none twice.
+fn seed_list(key: &str, seeds: Vec<u64>) -> Result<Vec<u64>> {
+    if seeds.is_empty() {
+        bail!("{key}: give at least one seed");
+    }
+    if let Some((i, s)) = seeds.iter().enumerate().find(|(i, s)| seeds[..*i].contains(s)) {
+        bail!("{key}[{i}]: seed {s} is listed twice");
+    }
+    Ok(seeds)
+}
+
+/// Finite points, at least one.
+fn point_list(key: &str, points: &[[Real; 3]]) -> Result<Vec<Point3>> {
+    if points.is_empty() {
+        bail!("{key}: give at least one point [x, y, z]");
+    }
+    points.iter().enumerate().map(|(k, p)| point(&format!("{key}[{k}]"), *p)).collect()
+}
+
+/// The maps built for `types` in `backends` (`None`: one each): one per patch type and
+/// backend, one `pc` map.
+fn map_count(input: &Input, types: &[MapKind], backends: Option<&[PatchBackend]>) -> usize {
+    let per_type = backends.map_or(1, <[PatchBackend]>::len);
+    match input {
+        Input::Map(_) => per_type,
+        _ => types.iter().map(|&k| if k == MapKind::Pc { 1 } else { per_type }).sum(),
+    }
+}
+
 /// A finite point.
 fn point(key: &str, p: [Real; 3]) -> Result<Point3> {
     if !p.iter().all(|c| c.is_finite()) {
@@ -286,10 +409,15 @@ pub fn load(path: &Path) -> Result<Config> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let raw: RawConfig = toml::from_str(&text).map_err(|e| {
-        let line = e.span().map(|s| {
-            text.as_bytes()[..s.start.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
-        });
-        let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+        let start = e.span().map(|s| s.start.min(text.len()));
+        let line = start.map(|s| text.as_bytes()[..s].iter().filter(|&&b| b == b'\n').count() + 1);
+        let mut message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+        // A value of the wrong type or range: name its key, as the checks below do.
+        if message.starts_with("invalid")
+            && let Some(key) = start.and_then(|s| key_at(&text, s))
+        {
+            message = format!("{key}: {message}");
+        }
         match line {
             Some(l) => anyhow::anyhow!("{} line {l}: {message}", path.display()),
             None => anyhow::anyhow!("{}: {message}", path.display()),
@@ -298,6 +426,28 @@ pub fn load(path: &Path) -> Result<Config> {
     let base = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
     let base = if base.as_os_str().is_empty() { PathBuf::from(".") } else { base };
     resolve(raw, &base, path)
+}
+
+/// The `table.key` whose value holds byte `offset` of `text`, when that line reads
+/// `key = value` below a `[table]` header (the layout of every key of this file).
+fn key_at(text: &str, offset: usize) -> Option<String> {
+    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[line_start..].lines().next()?;
+    let key = line.split_once('=')?.0.trim();
+    let bare = |k: &str| {
+        !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    };
+    if !bare(key) {
+        return None;
+    }
+    let table = text[..line_start].lines().rev().find_map(|l| {
+        let l = l.trim();
+        l.strip_prefix('[').filter(|r| !r.starts_with('[')).and_then(|r| r.split_once(']'))
+    });
+    Some(match table {
+        Some((t, _)) if bare(t.trim()) => format!("{}.{key}", t.trim()),
+        _ => key.to_owned(),
+    })
 }
 
 fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
@@ -393,6 +543,22 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
         (Some(s), Input::Mesh(_)) => positive("maps.spacing", s)?,
         (Some(_), _) => bail!("maps.spacing applies to `mesh` input only (its pc map)"),
         (None, _) => DEFAULT_SPACING,
+    };
+    for (key, given) in [
+        ("maps.mesh_edge", m.mesh_edge.is_some()),
+        ("maps.max_patch_triangles", m.max_patch_triangles.is_some()),
+    ] {
+        if given && !matches!(input, Input::Mesh(_)) {
+            bail!("{key} applies to `mesh` input only (its trimesh map)");
+        }
+        if given && !types.contains(&MapKind::Trimesh) {
+            bail!("{key} applies to the trimesh map, which maps.types leaves out");
+        }
+    }
+    let mesh_edge = m.mesh_edge.map(|e| positive("maps.mesh_edge", e)).transpose()?;
+    let max_patch_triangles = match m.max_patch_triangles {
+        Some(n) => count("maps.max_patch_triangles", n, MAX_PATCH_TRIANGLES_LIMIT)? as usize,
+        None => Tessellation::lab().max_patch_triangles,
     };
 
     let p = raw.plan;
@@ -499,6 +665,63 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
         })
         .transpose()?;
 
+    let demo = demo_settings();
+    let demo_seeds = || (1..=demo.timing_seeds).collect::<Vec<u64>>();
+    let timing = raw
+        .timing
+        .map(|t| -> Result<TimingConfig> {
+            Ok(TimingConfig {
+                iterations: t.iterations.map_or(Ok(demo.iterations), |n| {
+                    count("timing.iterations", n, MAX_ITERATIONS_LIMIT)
+                })?,
+                checkpoints: t.checkpoints.map_or(Ok(demo.checkpoints), |n| {
+                    count("timing.checkpoints", n, MAX_CHECKPOINTS)
+                })?,
+                seeds: seed_list("timing.seeds", t.seeds.unwrap_or_else(demo_seeds))?,
+                starts: match &t.starts {
+                    Some(s) => point_list("timing.starts", s)?,
+                    None => vec![plan.start],
+                },
+            })
+        })
+        .transpose()?;
+    let volume = raw
+        .volume
+        .map(|v| -> Result<VolumeConfig> {
+            let n = map_count(&input, &types, backends.as_deref());
+            if n > MAX_VOLUME_MAPS {
+                bail!(
+                    "[volume] compares at most {MAX_VOLUME_MAPS} maps, but maps.types × maps.backends \
+                     give {n}; list fewer"
+                );
+            }
+            Ok(VolumeConfig {
+                planner: match &v.planner {
+                    Some(p) => choice("volume.planner", p)?,
+                    None => ExplorePlanner::Rrt,
+                },
+                iterations: match (v.iterations, &timing) {
+                    (Some(n), _) => count("volume.iterations", n, MAX_ITERATIONS_LIMIT)?,
+                    (None, Some(t)) => t.iterations,
+                    (None, None) => demo.iterations,
+                },
+                seeds: match (v.seeds, &timing) {
+                    (Some(s), _) => seed_list("volume.seeds", s)?,
+                    (None, Some(t)) => t.seeds.clone(),
+                    (None, None) => demo_seeds(),
+                },
+                starts: match (&v.starts, &timing) {
+                    (Some(s), _) => point_list("volume.starts", s)?,
+                    (None, Some(t)) => t.starts.clone(),
+                    (None, None) => vec![plan.start],
+                },
+                cells: v.cells.map_or(Ok(demo.cells), |n| {
+                    count("volume.cells", n, MAX_CELLS).map(|c| c as u32)
+                })?,
+            })
+        })
+        .transpose()?;
+
     let out = base.join(raw.output.dir.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT)));
     if out.is_file() {
         bail!("output.dir: {} is a file, not a folder", out.display());
@@ -511,9 +734,13 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
         backends,
         sensor,
         spacing,
+        mesh_edge,
+        max_patch_triangles,
         plan,
         tof,
         terrain,
+        timing,
+        volume,
         out,
         write_3d: raw.output.write_3d.unwrap_or(true),
     })
@@ -525,6 +752,7 @@ mod tests {
 
     fn write(dir: &Path, text: &str) -> PathBuf {
         std::fs::write(dir.join("a.ply"), "").unwrap();
+        std::fs::write(dir.join("a.obj"), "").unwrap();
         let p = dir.join("run.toml");
         std::fs::write(&p, text).unwrap();
         p
@@ -578,5 +806,96 @@ mod tests {
         let text = "[input]\ncloud = \"a.ply\"\n[plan]\nstart = [0, nan, 1]\ngoals = [[1, 0, 1]]\n";
         let e = load(&write(dir.path(), text)).unwrap_err().to_string();
         assert!(e.contains("plan.start"), "{e}");
+    }
+
+    #[test]
+    fn timing_and_volume_take_the_demo_defaults_and_share_runs() {
+        let dir = tempfile::tempdir().unwrap();
+        let head = format!("[input]\ncloud = \"a.ply\"\n{PLAN}");
+        let c = load(&write(dir.path(), &format!("{head}[timing]\n[volume]\n"))).unwrap();
+        let demo = demo_settings();
+        let t = c.timing.as_ref().unwrap();
+        assert_eq!((t.iterations, t.checkpoints), (demo.iterations, demo.checkpoints));
+        assert_eq!(t.seeds, (1..=demo.timing_seeds).collect::<Vec<_>>());
+        assert_eq!(t.starts, vec![c.plan.start]);
+        let v = c.volume.as_ref().unwrap();
+        assert_eq!((v.planner, v.cells), (ExplorePlanner::Rrt, demo.cells));
+        assert!(v.shares_runs_with(t));
+        // Any difference in the runs, or the PRM, needs runs of its own.
+        for extra in ["planner = \"prm\"", "iterations = 10", "seeds = [9]", "starts = [[0, 0, 2]]"]
+        {
+            let text = format!("{head}[timing]\n[volume]\n{extra}\n");
+            let c = load(&write(dir.path(), &text)).unwrap();
+            assert!(!c.volume.unwrap().shares_runs_with(c.timing.as_ref().unwrap()), "{extra}");
+        }
+        // Without [timing], [volume] runs from the plan's start.
+        let c = load(&write(dir.path(), &format!("{head}[volume]\ncells = 7\n"))).unwrap();
+        let v = c.volume.unwrap();
+        assert_eq!((v.cells, v.starts), (7, vec![c.plan.start]));
+        assert!(c.timing.is_none());
+    }
+
+    #[test]
+    fn mesh_input_gives_every_map_type_and_its_trimesh_keys() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = format!(
+            "[input]\nmesh = \"a.obj\"\n[maps]\nmesh_edge = 0.2\nmax_patch_triangles = 9\n{PLAN}"
+        );
+        let c = load(&write(dir.path(), &text)).unwrap();
+        assert_eq!(c.types, MapKind::ALL.to_vec());
+        assert_eq!((c.mesh_edge, c.max_patch_triangles), (Some(0.2), 9));
+        let c = load(&write(dir.path(), &format!("[input]\nmesh = \"a.obj\"\n{PLAN}"))).unwrap();
+        assert_eq!((c.mesh_edge, c.max_patch_triangles), (None, 324));
+    }
+
+    #[test]
+    fn bad_timing_volume_and_trimesh_values_name_their_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let cloud = format!("[input]\ncloud = \"a.ply\"\n{PLAN}");
+        let mesh = format!("[input]\nmesh = \"a.obj\"\n{PLAN}");
+        let cases = [
+            (format!("{cloud}[timing]\niterations = -5\n"), "timing.iterations must be in 1..="),
+            (format!("{cloud}[timing]\ncheckpoints = 0\n"), "timing.checkpoints"),
+            (format!("{cloud}[timing]\nseeds = []\n"), "timing.seeds"),
+            (format!("{cloud}[timing]\nseeds = [4, 2, 4]\n"), "timing.seeds[2]: seed 4"),
+            (format!("{cloud}[timing]\nseeds = [1, -2]\n"), "timing.seeds: invalid value"),
+            (format!("{cloud}[timing]\nstarts = []\n"), "timing.starts"),
+            (format!("{cloud}[timing]\nstarts = [[0, 0, 1], [0, nan, 1]]\n"), "timing.starts[1]"),
+            (format!("{cloud}[timing]\nk = 3\n"), "unknown field `k`"),
+            (format!("{cloud}[volume]\ncells = 0\n"), "volume.cells must be in 1..=1024, not 0"),
+            (format!("{cloud}[volume]\ncells = 5000\n"), "volume.cells"),
+            (format!("{cloud}[volume]\niterations = -1\n"), "volume.iterations"),
+            (format!("{cloud}[volume]\nplanner = \"astar\"\n"), "volume.planner: unknown value"),
+            (format!("{cloud}[volume]\ncells = \"many\"\n"), "volume.cells: invalid type"),
+            (format!("{cloud}[maps]\nmesh_edge = 0.1\n"), "maps.mesh_edge applies to `mesh`"),
+            (format!("{mesh}[maps]\nmesh_edge = -0.1\n"), "maps.mesh_edge"),
+            (format!("{mesh}[maps]\nmax_patch_triangles = 0\n"), "maps.max_patch_triangles"),
+            (
+                format!("{mesh}[maps]\ntypes = [\"planes\"]\nmax_patch_triangles = 5\n"),
+                "maps.max_patch_triangles applies to the trimesh map",
+            ),
+            (format!("{mesh}[maps]\ntypes = [\"voxels\"]\n"), "maps.types[0]: unknown value"),
+            (
+                format!(
+                    "{mesh}[maps]\nbackends = [\"polygon\", \"bbox6d\", \"trimesh\"]\n[volume]\n"
+                ),
+                "[volume] compares at most 8 maps",
+            ),
+            (format!("{cloud}max_iterations = -5\n"), "plan.max_iterations: invalid value"),
+        ];
+        for (text, needle) in &cases {
+            let e = load(&write(dir.path(), text)).unwrap_err().to_string();
+            assert!(e.contains(needle) && !e.contains('\n'), "{needle}: {e}");
+        }
+    }
+
+    #[test]
+    fn keys_are_found_under_their_table() {
+        let text = "[input]\ncloud = \"a\"\n\n[plan] # the plan\nseeds = [1, -2]\n";
+        let at = text.find("-2").unwrap();
+        assert_eq!(key_at(text, at).as_deref(), Some("plan.seeds"));
+        assert_eq!(key_at(text, 0), None, "a header has no key");
+        assert_eq!(key_at("x = 1\n", 4).as_deref(), Some("x"));
+        assert_eq!(key_at("[a]\n\"odd key\" = 1\n", 14), None);
     }
 }

@@ -1,11 +1,14 @@
 //! The stages of `patchnav run`: filter the ToF frame and classify the terrain frame if given,
 //! read the input, build the map types in their backends, plan with every planner and seed on
-//! every map, and collect it all in the demo's [`DemoResults`].
+//! every map, time RRTs and compare explored volumes if asked, and collect it all in the demo's
+//! [`DemoResults`].
 
 use super::config::{Config, Input, TerrainConfig, TofConfig};
 use crate::demo::model::{
-    DemoResults, MapDrawing, MapRow, PlanRun, SceneInfo, TerrainSection, TofSection,
+    DemoResults, MapDrawing, MapRow, PlanRun, SceneInfo, TerrainSection, TimingCurve, TofSection,
+    VolumeSection,
 };
+use crate::demo::pipeline::explore::{Exploration, ExplorePlanner, Target, explore};
 use crate::demo::pipeline::maps::{drawing, patch_mesh};
 use crate::demo::pipeline::{
     Clock, Files, MAX_DRAWN, decimate, p3, p3mm, write_mesh_f32, write_ply_f32,
@@ -14,7 +17,9 @@ use crate::extract::SensorPreset;
 use crate::input::InputArgs;
 use crate::plan::{PlannerChoice, make_planner, write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
-use crate::scene_map::{MapKind, PatchBackend, patch_map, planar_triangles};
+use crate::scene_map::{
+    MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map, planar_triangles,
+};
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
 use patch_core::{CapsuleStep, Isometry3, Patch, Point3, UnspecificStepIntersector};
@@ -45,8 +50,9 @@ pub struct Built {
 enum Source {
     /// Scans in their sensor frames with their poses.
     Scans(Vec<PointCloud>),
-    /// A mesh's patches.
-    Patches(Vec<Patch>),
+    /// A mesh's surfaces: its planar patches (coplanar faces merged) and the trimesh patches
+    /// of faces that make no valid polygon, with the mesh's box.
+    Mesh(SceneSurfaces, Aabb),
     /// A map file's map.
     Map(AnyMap),
     /// World points.
@@ -135,7 +141,14 @@ fn read(config: &Config, progress: &Progress) -> Result<Source> {
             if patches.is_empty() {
                 bail!("input.mesh: {} has no usable faces", path.display());
             }
-            Source::Patches(patches)
+            let mut surfaces = SceneSurfaces { planar: Vec::new(), curved: Vec::new() };
+            for p in patches {
+                match p {
+                    Patch::Planar(p) => surfaces.planar.push(p),
+                    Patch::Trimesh(m) => surfaces.curved.push(m),
+                }
+            }
+            Source::Mesh(surfaces, mesh.bounds())
         }
         Input::Map(path) => Source::Map(crate::map::open_map(path)?),
         Input::Cloud(path) => {
@@ -156,6 +169,16 @@ struct Maps {
 }
 
 impl Maps {
+    /// The name of `m` in file names, timing curves and the volume table: its type, or type
+    /// and backend when the type is in several backends.
+    fn name(&self, m: &Built) -> String {
+        if self.built.iter().filter(|b| b.kind == m.kind).count() > 1 {
+            format!("{}-{}", m.kind, m.map.backend())
+        } else {
+            m.kind.name().to_owned()
+        }
+    }
+
     /// Loads `patches` into every backend, records the rows, the drawing and the mesh file.
     fn add_patches(
         &mut self,
@@ -275,6 +298,20 @@ impl Maps {
     }
 }
 
+/// How a mesh's trimesh map is made (thesis §6.1: the trimesh map holds every surface as
+/// triangles): the mesh's surfaces are triangulated (planar patches by constrained Delaunay),
+/// split until no edge is longer than `maps.mesh_edge` (unsplit without it: twice the mesh's
+/// box diagonal bounds every edge) and cut into patches of at most `maps.max_patch_triangles`,
+/// as [`SceneSurfaces::patches`] meshes a simulated scene.
+fn mesh_tessellation(config: &Config, bounds: &Aabb) -> Tessellation {
+    let diagonal = (bounds.max - bounds.min).norm();
+    Tessellation {
+        mesh_edge: config.mesh_edge.unwrap_or(2.0 * diagonal.max(1.0)),
+        max_patch_triangles: config.max_patch_triangles,
+        ..Tessellation::lab()
+    }
+}
+
 /// Builds the configured map types from `source`.
 fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files) -> Result<Maps> {
     let mut maps = Maps { built: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
@@ -308,39 +345,29 @@ fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files
                 bar.inc(1);
             }
         }
-        Source::Patches(patches) => {
+        Source::Mesh(surfaces, bounds) => {
+            let tessellation = mesh_tessellation(config, &bounds);
             for &kind in &config.types {
                 let t0 = Instant::now();
-                match kind {
-                    MapKind::Planes => {
-                        let planar: Vec<Patch> =
-                            patches.iter().filter(|p| p.as_planar().is_some()).cloned().collect();
-                        maps.add_patches(
-                            kind,
-                            planar,
-                            t0.elapsed().as_secs_f64(),
-                            &backends,
-                            files,
-                            w,
-                        )?;
-                    }
-                    MapKind::Hybrid => {
-                        maps.add_patches(
-                            kind,
-                            patches.clone(),
-                            t0.elapsed().as_secs_f64(),
-                            &backends,
-                            files,
-                            w,
-                        )?;
-                    }
-                    MapKind::Pc => {
-                        let points = sample_patch_points(&patches, config.spacing)?;
+                let patches = surfaces.patches(kind, &tessellation).with_context(|| {
+                    format!("maps.mesh_edge: meshing the {kind} map of the mesh")
+                })?;
+                match patches {
+                    Some(patches) => maps.add_patches(
+                        kind,
+                        patches,
+                        t0.elapsed().as_secs_f64(),
+                        &backends,
+                        files,
+                        w,
+                    )?,
+                    None => {
+                        let hybrid = surfaces
+                            .patches(MapKind::Hybrid, &tessellation)?
+                            .context("the hybrid map has patches")?;
+                        let points = sample_patch_points(&hybrid, config.spacing)?;
                         let map = point_map(&points)?;
                         maps.add_map(kind, map, t0.elapsed().as_secs_f64(), files, w)?;
-                    }
-                    MapKind::Trimesh => {
-                        bail!("maps.types: a trimesh map cannot be built from a mesh")
                     }
                 }
                 bar.inc(1);
@@ -372,6 +399,96 @@ fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files
     Ok(maps)
 }
 
+/// Checks every start (`plan.start`, `timing.starts`, `volume.starts`) before any run.
+fn check_starts(config: &Config, maps: &Maps) -> Result<()> {
+    let r = config.plan.radius;
+    check_start("plan.start", &config.plan.start, maps, r)?;
+    let lists = [
+        ("timing", config.timing.as_ref().map(|t| &t.starts)),
+        ("volume", config.volume.as_ref().map(|v| &v.starts)),
+    ];
+    for (section, starts) in lists {
+        for (k, s) in starts.into_iter().flatten().enumerate() {
+            check_start(&format!("{section}.starts[{k}]"), s, maps, r)?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks that `start` (the value of `key`) lies in every map's box and is free (no surface
+/// within `radius`): the commonest mistake, named in one line.
+fn check_start(key: &str, start: &Point3, maps: &Maps, radius: f64) -> Result<()> {
+    let at = format!("{key} ({}, {}, {})", start.x, start.y, start.z);
+    for m in &maps.built {
+        let b = crate::map::map_bounds(&m.map);
+        if !b.contains(start) {
+            bail!(
+                "{at} is outside the {} map's box ({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
+                m.kind,
+                b.min.x,
+                b.min.y,
+                b.min.z,
+                b.max.x,
+                b.max.y,
+                b.max.z
+            );
+        }
+        if !CapsuleStep::sphere(*start, radius).is_ok_and(|s| m.map.is_step_free(&s)) {
+            bail!(
+                "{at} is not free on the {} map: a surface is within plan.radius = {radius} m",
+                m.kind
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The RRT timing curves (`[timing]`, Fig 6.4) and the explored-volume comparison
+/// (`[volume]`, Table 6.2 / 6.4, Fig 6.1) on every map, as the demo makes them
+/// ([`explore`]); one set of runs gives both when `[volume]` asks for the timed RRTs' very
+/// runs (its defaults).
+fn timing_and_volume(
+    config: &Config,
+    maps: &Maps,
+    progress: &Progress,
+) -> Result<(Vec<TimingCurve>, Option<VolumeSection>)> {
+    let p = &config.plan;
+    let targets: Vec<Target<'_>> =
+        maps.built.iter().map(|m| Target { name: maps.name(m), map: &m.map }).collect();
+    let run = |planner, iterations, starts, seeds, checkpoints, cells| {
+        let e = Exploration {
+            planner,
+            iterations,
+            starts,
+            seeds,
+            radius: p.radius,
+            step: p.step,
+            checkpoints,
+            cells,
+        };
+        explore(&targets, &e, progress)
+    };
+    let mut curves = Vec::new();
+    if let Some(t) = &config.timing {
+        let shared = config.volume.as_ref().filter(|v| v.shares_runs_with(t));
+        let (c, volume) = run(
+            ExplorePlanner::Rrt,
+            t.iterations,
+            &t.starts,
+            &t.seeds,
+            Some(t.checkpoints),
+            shared.map(|v| v.cells),
+        )?;
+        if shared.is_some() {
+            return Ok((c, volume));
+        }
+        curves = c;
+    }
+    let Some(v) = &config.volume else { return Ok((curves, None)) };
+    let (_, volume) = run(v.planner, v.iterations, &v.starts, &v.seeds, None, Some(v.cells))?;
+    Ok((curves, volume))
+}
+
 /// Whether `planner` runs on `map` (the Evasion and medial-axis planners need patch maps:
 /// thesis Table 5.2).
 pub fn planner_fits(planner: PlannerChoice, map: &AnyMap) -> bool {
@@ -388,36 +505,6 @@ fn plan(
     files: &mut Files,
 ) -> Result<(Vec<PlanRun>, Vec<String>)> {
     let p = &config.plan;
-    // The start must be free on every map before any run: the commonest mistake.
-    for m in &maps.built {
-        let bounds = crate::map::map_bounds(&m.map);
-        if !bounds.contains(&p.start) {
-            bail!(
-                "plan.start ({}, {}, {}) is outside the {} map's box ({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
-                p.start.x,
-                p.start.y,
-                p.start.z,
-                m.kind,
-                bounds.min.x,
-                bounds.min.y,
-                bounds.min.z,
-                bounds.max.x,
-                bounds.max.y,
-                bounds.max.z
-            );
-        }
-        let free = CapsuleStep::sphere(p.start, p.radius).is_ok_and(|s| m.map.is_step_free(&s));
-        if !free {
-            bail!(
-                "plan.start ({}, {}, {}) is not free on the {} map: a surface is within plan.radius = {} m",
-                p.start.x,
-                p.start.y,
-                p.start.z,
-                m.kind,
-                p.radius
-            );
-        }
-    }
     let problem = Problem {
         start: p.start,
         goals: p.goals.iter().map(|&center| Goal { center, tolerance: p.goal_tolerance }).collect(),
@@ -426,7 +513,6 @@ fn plan(
     let bar = progress.bar(maps.built.len() as u64 * runs_per_map, "planning");
     let mut runs = Vec::new();
     let mut skipped = Vec::new();
-    let several_backends = |kind: MapKind| maps.built.iter().filter(|b| b.kind == kind).count() > 1;
     for m in &maps.built {
         let space = PlanningSpace::new(crate::map::map_bounds(&m.map), p.radius, p.step)
             .with_context(|| format!("the {} map's planning space", m.kind))?;
@@ -457,11 +543,7 @@ fn plan(
                 let graph = run.roadmap();
                 let name = choice.cli_name();
                 if k == 0 && config.write_3d {
-                    let tag = if several_backends(m.kind) {
-                        format!("{}-{}-{name}", m.kind, m.map.backend())
-                    } else {
-                        format!("{}-{name}", m.kind)
-                    };
+                    let tag = format!("{}-{name}", maps.name(m));
                     let file = format!("roadmap-{tag}.obj");
                     write_obj_roadmap(&files.path(&file), graph)?;
                     files.add(
@@ -669,8 +751,16 @@ pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<Str
     clock.lap("input: read");
     let maps = build(config, source, progress, &mut files)?;
     clock.lap("maps: extract and load");
+    check_starts(config, &maps)?;
     let (plans, skipped) = plan(config, &maps, progress, &mut files)?;
     clock.lap("planning");
+    let (timing, volume) = timing_and_volume(config, &maps, progress)?;
+    match (&config.timing, &config.volume) {
+        (Some(_), Some(_)) => clock.lap("RRT timing and explored volume"),
+        (Some(_), None) => clock.lap("RRT timing"),
+        (None, Some(_)) => clock.lap("explored volume"),
+        (None, None) => {}
+    }
     let bounds = maps
         .built
         .iter()
@@ -694,8 +784,8 @@ pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<Str
         maps: maps.rows,
         drawings: maps.drawings,
         plans,
-        timing: Vec::new(),
-        volume: None,
+        timing,
+        volume,
         files: files.entries,
     };
     Ok((results, skipped))

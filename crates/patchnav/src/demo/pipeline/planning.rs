@@ -2,22 +2,20 @@
 //! (path metrics, thesis §5.6), RRTs timed against iterations (Fig 6.4, thesis Algorithm 13
 //! as run for §6.1) and their explored volumes compared (Table 6.2, Fig 6.1).
 
+use super::explore::{Exploration, ExplorePlanner, Target, explore};
 use super::maps::Built;
 use super::{
     Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, SCAN_HEIGHT, STEP, Settings, decimate, p3, p3mm,
 };
 use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
-use crate::experiment::lab::{
-    CheckpointTimer, LabMapArgs, checkpoints, common_box, corner_starts, explored,
-};
+use crate::experiment::lab::{LabMapArgs, common_box, corner_starts};
 use crate::plan::{write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
 use crate::scene_map::{BuiltMap, MapKind, MapSource, PatchBackend};
 use anyhow::{Context, Result, bail};
 use patch_core::Point3;
 use patch_map::AnyMap;
-use roadmap::metrics::{quantile, turn_angles, upper_quartile};
-use roadmap::volume::{CongruenceTable, VoxelGrid};
+use roadmap::metrics::{turn_angles, upper_quartile};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, PlanningSpace,
     Prm, PrmConfig, Problem, Rrt, RrtConfig,
@@ -231,7 +229,7 @@ pub(super) fn plan_all(
 /// `timing_seeds` seeds on every map, timed at checkpoints (Fig 6.4: median and quartiles per
 /// map type), and rasterises each map type's explored space (every edge, every free vertex)
 /// into one voxel grid covering all maps: the congruence table (Table 6.2) and a horizontal
-/// slice at the start height (Fig 6.1).
+/// slice at the start height (Fig 6.1). See [`explore`].
 pub(super) fn timing_and_volume(
     built: &Built,
     starts: &[Point3],
@@ -239,80 +237,19 @@ pub(super) fn timing_and_volume(
     settings: &Settings,
     progress: &Progress,
 ) -> Result<(Vec<TimingCurve>, VolumeSection)> {
-    let cps = checkpoints(settings.iterations, settings.checkpoints);
-    let bounds: Vec<_> = built.maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
-    let all = bounds.iter().fold(pointcloud::Aabb::EMPTY, |a, b| a.union(b));
-    let empty = VoxelGrid::covering(bounds, settings.cells)?;
-    let starts = &starts[..settings.timing_starts.min(starts.len())];
-    let bar = progress
-        .bar((built.maps.len() * starts.len()) as u64 * settings.timing_seeds, "rrt timing");
-    let mut curves = Vec::new();
-    let mut grids = Vec::new();
-    for m in &built.maps {
-        let space = space(m)?;
-        let mut grid = empty.empty_like();
-        let mut runs: Vec<Vec<f64>> = Vec::new();
-        for &start in starts {
-            for s in 0..settings.timing_seeds {
-                let mut rrt = Rrt::new(&m.map, space, RrtConfig::thesis(), seed.wrapping_add(s));
-                let mut timer = CheckpointTimer::new(cps.clone());
-                let status = rrt.solve(&Problem { start, goals: Vec::new() }, &mut timer);
-                if status == PlannerStatus::InvalidStart {
-                    bail!("a start is not free on the {} map", m.kind);
-                }
-                if timer.seconds.len() != cps.len() {
-                    bail!("an RRT on the {} map stopped early", m.kind);
-                }
-                runs.push(timer.seconds);
-                grid.add_roadmap(&explored(rrt.roadmap(), &m.map, RADIUS)?, RADIUS)?;
-                bar.inc(1);
-            }
-        }
-        let q = |c: usize, p: f64| {
-            let v: Vec<f64> = runs.iter().map(|r| r[c]).collect();
-            quantile(&v, p).unwrap_or(f64::NAN) * 1e3
-        };
-        curves.push(TimingCurve {
-            map: m.kind.name().to_owned(),
-            iterations: cps.clone(),
-            median_ms: (0..cps.len()).map(|c| q(c, 0.5)).collect(),
-            q1_ms: (0..cps.len()).map(|c| q(c, 0.25)).collect(),
-            q3_ms: (0..cps.len()).map(|c| q(c, 0.75)).collect(),
-        });
-        grids.push(grid);
-    }
-    bar.finish_and_clear();
-    let names: Vec<&str> = built.maps.iter().map(|m| m.kind.name()).collect();
-    let table = CongruenceTable::new(names.iter().copied().zip(&grids))?;
-    let n = names.len();
-    let volumes_m3: Vec<f64> = (0..n).map(|i| table.volume(i)).collect();
-    let table: Vec<Vec<Option<f64>>> =
-        (0..n).map(|i| (0..n).map(|j| table.percent_not_in(i, j)).collect()).collect();
-    // The slice: the layer of cells holding the first start's height, over the maps' box.
-    let (min, cell, cells) = (empty.min(), empty.cell_size(), empty.cells_per_axis());
-    let z = starts.first().map_or(all.min.z, |s| s.z);
-    let k = (((z - min.z) / cell).floor().max(0.0) as u32).min(cells - 1);
-    let span = |lo: f64, hi: f64| (((hi - lo) / cell).ceil() as u32).clamp(1, cells);
-    let (nx, ny) = (span(min.x, all.max.x), span(min.y, all.max.y));
-    let mut bits = Vec::with_capacity((nx * ny) as usize);
-    for j in 0..ny {
-        for i in 0..nx {
-            let b = grids
-                .iter()
-                .enumerate()
-                .fold(0u8, |b, (g, grid)| b | (u8::from(grid.contains(i, j, k)) << g));
-            bits.push(b);
-        }
-    }
-    let volume = VolumeSection {
-        cell,
-        maps: names.iter().map(|s| (*s).to_owned()).collect(),
-        volumes_m3,
-        table,
-        slice_z: empty.cell_center(0, 0, k).z,
-        slice_origin: [min.x, min.y],
-        slice_size: [nx, ny],
-        slice_bits: bits,
+    let targets: Vec<Target<'_>> =
+        built.maps.iter().map(|m| Target { name: m.kind.name().to_owned(), map: &m.map }).collect();
+    let seeds: Vec<u64> = (0..settings.timing_seeds).map(|s| seed.wrapping_add(s)).collect();
+    let exploration = Exploration {
+        planner: ExplorePlanner::Rrt,
+        iterations: settings.iterations,
+        starts: &starts[..settings.timing_starts.min(starts.len())],
+        seeds: &seeds,
+        radius: RADIUS,
+        step: STEP,
+        checkpoints: Some(settings.checkpoints),
+        cells: Some(settings.cells),
     };
-    Ok((curves, volume))
+    let (curves, volume) = explore(&targets, &exploration, progress)?;
+    Ok((curves, volume.context("the demo asks for the explored volume")?))
 }

@@ -203,6 +203,9 @@ mod tests {
     #[test]
     fn slice_is_flipped_and_counted() {
         let vol = VolumeSection {
+            planner: "rrt".into(),
+            runs: 1,
+            iterations: 10,
             cell: 0.1,
             maps: vec!["planes".into(), "pc".into()],
             volumes_m3: vec![],
