@@ -75,7 +75,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::hash::{BuildHasherDefault, Hasher};
 
-use patch_core::{Aabb, Point3, Real, Vector3};
+use patch_core::{Aabb, CapsuleStep, Point3, Real, StepError, UnspecificStepIntersector, Vector3};
 
 use crate::Roadmap;
 
@@ -106,6 +106,26 @@ pub enum VolumeError {
     /// The two grids do not share the same lattice ([`VoxelGrid::same_lattice`]).
     #[error("the voxel grids have different lattices (origin, cell size or cells per axis)")]
     LatticeMismatch,
+}
+
+/// The part of `roadmap` that is explored space (thesis §6.2): every edge, and every vertex
+/// with an edge or whose sphere of `radius` is free on `map`. The thesis's PRM adds samples
+/// without a validity check (Algorithm 14, spec §4), so a sample inside an obstacle stays an
+/// isolated vertex; its sphere is not explored volume.
+///
+/// # Errors
+/// [`StepError`] for a radius that is not positive and finite.
+pub fn explored_part<M>(roadmap: &Roadmap, map: &M, radius: Real) -> Result<Roadmap, StepError>
+where
+    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+{
+    let mut free = Vec::with_capacity(roadmap.node_count());
+    for v in roadmap.node_indices() {
+        let keep = roadmap.neighbors(v).next().is_some()
+            || map.is_step_free(&CapsuleStep::sphere(roadmap[v], radius)?);
+        free.push(keep);
+    }
+    Ok(roadmap.filter_map(|v, p| free[v.index()].then_some(*p), |_, w| Some(*w)))
 }
 
 /// Whether the point `p` lies within `radius` of the segment `a`–`b` (closed: distance

@@ -657,17 +657,9 @@ fn timing_svg(runs: &[TimedRun], cps: &[u64], kinds: &[MapKind], a: &LabMapArgs)
     o
 }
 
-/// The part of `roadmap` that is explored space: every edge, and every vertex whose sphere is
-/// free. The PRM adds samples without a validity check (thesis Algorithm 14, spec §4), so a
-/// sample inside an obstacle stays an isolated vertex; its sphere is not explored volume.
+/// The explored part of `roadmap` ([`roadmap::volume::explored_part`]).
 pub(crate) fn explored(roadmap: &Roadmap, map: &AnyMap, radius: Real) -> Result<Roadmap> {
-    let mut free = Vec::with_capacity(roadmap.node_count());
-    for v in roadmap.node_indices() {
-        let keep = roadmap.neighbors(v).next().is_some()
-            || map.is_step_free(&CapsuleStep::sphere(roadmap[v], radius)?);
-        free.push(keep);
-    }
-    Ok(roadmap.filter_map(|v, p| free[v.index()].then_some(*p), |_, w| Some(*w)))
+    Ok(roadmap::volume::explored_part(roadmap, map, radius)?)
 }
 
 /// Runs `patchnav experiment lab-volume`.
