@@ -8,18 +8,22 @@
 //! scene and backend, under `target/bench/ompl/` (see [`crate::ompl_log`]).
 //!
 //! # The lab's maps from scans
-//! The matrix's `lab-scans-*` scenes (thesis Fig 6.4 as the thesis ran it) plan on the lab's
-//! four map types built from simulated ALRF scans. The scan → extraction pipeline lives in
-//! `patchnav`, so when the selection runs any of those scenes (no `--scene`, `--scene
-//! lab-scans`, or a `lab-scans-*` name) this command builds the release `patchnav` and, once,
-//! the four map files with `patchnav map build --scene lab --kind K --source scans` (patch
-//! maps in the polygon backend, the pc map as a point-cloud map) into
-//! `target/bench/lab-maps/<key>/`, the key naming every build parameter ([`LabMapParams`]).
+//! The matrix's `lab-scans-*` scenes (thesis Fig 6.4 as the thesis ran it) and the
+//! `lab-volume` benchmark (Tables 6.1, 6.2, 6.4) use the lab's four map types built from
+//! simulated ALRF scans. The scan → extraction pipeline lives in `patchnav`, so when the
+//! selection runs any of those scenes (the matrix with no `--scene`, `--scene lab-scans`, or a
+//! `lab-scans-*` name) or `lab-volume` (named, or all benchmarks) this command builds the
+//! release `patchnav` and, once, the four map files with `patchnav map build --scene lab
+//! --kind K --source scans` (patch maps in the polygon backend, the pc map as a point-cloud
+//! map) into `target/bench/lab-maps/<key>/`, the key naming every build parameter
+//! ([`LabMapParams`]); both benchmarks read the same folder.
 //! The folder is reused while its `build.json` (written last, after all four maps) is newer
 //! than the `patchnav` binary, so a changed pipeline rebuilds it. `bench-matrix` gets the
 //! folder in `$PATCHNAV_LAB_MAPS`. `--lab-scans N` (default 8, `patchnav experiment
 //! lab-timing`'s default; the thesis's Lab has 29) and `--lab-scan-step-deg D` (default: the
-//! S300's 0.5°) choose the scans.
+//! S300's 0.5°) choose the scans. `lab-volume` takes `--seeds N` and `--jobs N` as the matrix
+//! does, and its size from the environment `bench-matrix` inherits
+//! (`PATCHNAV_LAB_VOLUME_K`, `_PRM_K`, `_STARTS`, `_CELLS`).
 
 use anyhow::{Context, Result, bail};
 use serde_json::Value;
@@ -173,6 +177,18 @@ fn runs_lab_scans(names: &[String], matrix: &[String]) -> bool {
             || scenes.iter().any(|s| *s == "lab-scans" || s.starts_with("lab-scans-")))
 }
 
+/// Whether the selection runs the `lab-volume` benchmark: it is named, or no name is given
+/// (all benchmarks).
+fn runs_lab_volume(names: &[String]) -> bool {
+    names.is_empty() || names.iter().any(|n| n == "lab-volume")
+}
+
+/// Whether the selection needs the lab's maps from scans: it runs a `lab-scans-*` scene of
+/// the matrix or the `lab-volume` benchmark (both read the same cached build).
+fn needs_lab_maps(names: &[String], matrix: &[String]) -> bool {
+    runs_lab_scans(names, matrix) || runs_lab_volume(names)
+}
+
 /// Whether `dir` holds a complete build newer than `binary`: all four map files and
 /// `build.json` (written last), whose modification time is not before the binary's.
 pub fn lab_maps_fresh(dir: &Path, binary: &Path) -> bool {
@@ -267,7 +283,7 @@ pub fn run(args: &[String]) -> Result<()> {
         return Ok(());
     }
     cmd.arg("--seed").arg(args.seed.to_string()).args(&args.names).args(&args.matrix);
-    if runs_lab_scans(&args.names, &args.matrix) {
+    if needs_lab_maps(&args.names, &args.matrix) {
         cmd.env("PATCHNAV_LAB_MAPS", lab_maps(&args.lab)?);
     }
     let provenance = crate::provenance::collect(args.seed);
@@ -407,6 +423,16 @@ mod tests {
         assert!(runs_lab_scans(&[], &strings(&["--scene", "lab-scans-pc", "--jobs", "2"])));
         assert!(!runs_lab_scans(&strings(&["tof"]), &[]));
         assert!(!runs_lab_scans(&[], &strings(&["--jobs", "2", "--scene", "lab"])));
+        // lab-volume reads the same maps, whatever the matrix's scenes.
+        assert!(needs_lab_maps(&strings(&["lab-volume"]), &[]));
+        assert!(needs_lab_maps(&strings(&["tof", "lab-volume"]), &strings(&["--seeds", "3"])));
+        assert!(needs_lab_maps(&[], &strings(&["--scene", "office"])), "all benchmarks");
+        assert!(!needs_lab_maps(&strings(&["roadmap"]), &strings(&["--scene", "office"])));
+        assert!(!needs_lab_maps(&strings(&["tof", "io"]), &[]));
+        assert!(needs_lab_maps(&strings(&["roadmap"]), &[]), "the whole matrix");
+        let v = parse(&strings(&["lab-volume", "--seeds", "24", "--jobs", "2"])).unwrap();
+        assert_eq!(v.matrix, ["--seeds", "24", "--jobs", "2"], "--seeds and --jobs pass through");
+        assert!(needs_lab_maps(&v.names, &v.matrix) && !runs_matrix(&v.names));
         // Every parameter is in the key.
         let base = p.lab.clone();
         assert_eq!(base.scans, 3);

@@ -39,6 +39,8 @@ commands:
   fixtures [--check]                    regenerate fixtures/ (or check they are current)
   bench [NAME ...] [--seed N] [--out F] run named benchmarks (default: all), append JSONL rows
   bench --list                          list the benchmark names
+  bench lab-volume [--seeds N] [--jobs N]
+                                        Tables 6.1, 6.2, 6.4 on the lab maps built from scans
   bench roadmap [--scene S] [--backend B] [--planner P] [--seeds N] [--jobs N] [--resume]
                                         the planning matrix (scenes x backends x planners x seeds);
                                         scenes office, lab, lab-scans (maps built from simulated

@@ -18,6 +18,7 @@ use scene_sim::{Alrf, RangeCamera, RangeSensor, StereoCamera, scene_by_name};
 use serde_json::{Value, json};
 use std::time::Instant;
 
+mod lab_volume;
 mod roadmap;
 mod terrain;
 
@@ -71,6 +72,14 @@ const BENCHES: &[Bench] = &[
                 --scene, --backend, --planner (repeatable or comma-separated), --seeds N, --jobs N, \
                 --resume FILE (case keys to skip, one a line)",
         run: Run::Matrix(roadmap::run),
+    },
+    Bench {
+        name: "lab-volume",
+        about: "Tables 6.1, 6.2, 6.4: what the lab's four maps from scans hold, and the explored \
+                volume of RRT (4 corner starts x --seeds) and PRM (--seeds) on each with the % \
+                not explored on the others ($PATCHNAV_LAB_MAPS; --seeds N, --jobs N; \
+                PATCHNAV_LAB_VOLUME_K, _PRM_K, _STARTS, _CELLS)",
+        run: Run::Matrix(lab_volume::run),
     },
 ];
 

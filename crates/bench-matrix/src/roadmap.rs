@@ -48,7 +48,7 @@
 //! the times stay per-run wall times, but runs compete for caches and memory bandwidth: every
 //! row records `jobs`, and timing tables should come from `--jobs 1`.
 
-mod lab_maps;
+pub(crate) mod lab_maps;
 mod lab_scene;
 mod planners;
 

@@ -17,6 +17,7 @@
 
 mod lab;
 mod office;
+mod volume;
 
 use anyhow::{Context, Result, bail};
 use lab::{lab_scans_section, lab_table};
@@ -87,6 +88,9 @@ pub struct Matrix {
     pub dates: (String, String),
     /// Per scene, the git revision whose rows are used.
     pub scene_revisions: BTreeMap<String, String>,
+    /// The rows of bench `lab-volume` (Tables 6.1, 6.2, 6.4; [`volume::volume_section`] picks
+    /// the last run).
+    pub volume: Vec<Value>,
 }
 
 impl Matrix {
@@ -101,6 +105,11 @@ impl Matrix {
             .collect();
         let scene = |r: &Value| r.get("scene").and_then(Value::as_str).unwrap_or("").to_owned();
         let mut m = Matrix {
+            volume: rows
+                .iter()
+                .filter(|r| r.get("bench").and_then(Value::as_str) == Some("lab-volume"))
+                .cloned()
+                .collect(),
             revision: ours.last().map(|r| rev(r)).unwrap_or_default(),
             scene_revisions: ours.iter().map(|r| (scene(r), rev(r))).collect(),
             ..Matrix::default()
@@ -267,6 +276,8 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
         o.push('\n');
         o.push_str(&scans);
     }
+    o.push('\n');
+    o.push_str(&volume::volume_section(&m.volume));
     Ok(o)
 }
 

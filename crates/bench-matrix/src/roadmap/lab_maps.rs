@@ -69,6 +69,23 @@ pub(crate) fn map_bounds(map: &AnyMap) -> Aabb {
     }
 }
 
+/// The box common to all of `boxes` (their intersection; a box that misses another shrinks
+/// to a flat or point box at the larger min corner, so it stays well formed); the empty box
+/// for none.
+pub(crate) fn common_box(boxes: impl IntoIterator<Item = Aabb>) -> Aabb {
+    let mut boxes = boxes.into_iter();
+    let Some(first) = boxes.next() else { return Aabb::EMPTY };
+    boxes.fold(first, |a, b| {
+        let (min, max) = (a.min.sup(&b.min), a.max.inf(&b.max));
+        Aabb::new(min, max.sup(&min))
+    })
+}
+
+/// The path of the map file of `kind` in `folder`: `<kind>.pmap`.
+pub(crate) fn map_path(folder: &Path, kind: &str) -> PathBuf {
+    folder.join(format!("{kind}.pmap"))
+}
+
 /// Reads the four map files of `folder` and finds the start (robot `radius`).
 ///
 /// # Errors
@@ -78,7 +95,7 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
     let mut maps = Vec::new();
     let mut bounds = Vec::new();
     for kind in KINDS {
-        let path = folder.join(format!("{kind}.pmap"));
+        let path = map_path(folder, kind);
         let file = File::open(&path).with_context(|| {
             format!(
                 "opening {} (build it with `patchnav map build --scene lab --kind {kind} \
@@ -107,10 +124,7 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
         maps.push((kind, Some(map)));
         bounds.push((kind, b));
     }
-    let common = bounds.iter().skip(1).fold(bounds[0].1, |a, (_, b)| {
-        let (min, max) = (a.min.sup(&b.min), a.max.inf(&b.max));
-        Aabb::new(min, max.sup(&min))
-    });
+    let common = common_box(bounds.iter().map(|(_, b)| *b));
     let all: Vec<&AnyMap> = maps.iter().filter_map(|(_, m)| m.as_ref()).collect();
     let start = lab_scene::corner_start(&all, radius, Some(&common))
         .with_context(|| format!("the maps of {}", folder.display()))?;
