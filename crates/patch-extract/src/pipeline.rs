@@ -61,6 +61,17 @@ impl PipelineConfig {
         }
     }
 
+    /// For structured-light depth frames (Kinect-like): [`SegmentConfig::structured_light`],
+    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    pub fn structured_light() -> PipelineConfig {
+        PipelineConfig {
+            segment: SegmentConfig::structured_light(),
+            polygonize: PolygonizeConfig::thesis(),
+            remainder: None,
+            merge: Some(MergeConfig::alrf()),
+        }
+    }
+
     /// For noise-free scans of synthetic scenes: [`SegmentConfig::exact`],
     /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::exact`].
     pub fn exact() -> PipelineConfig {

@@ -387,3 +387,56 @@ fn camera_scaled(f: Real) -> SegmentConfig {
     c.noise.sigma_0 *= f;
     c
 }
+
+/// A 320 × 240 organised frame of a wall at 45° (z = 3 + x) before a structured-light camera
+/// (57° × 43° field of view), 2–6.5 m away, with Kinect-like depth: Gaussian noise of
+/// σ(z) = 1.2 mm + 1.9 mm/m² · z² and depth quantised to disparity steps of 2.85 mm/m² · z².
+fn kinect_wall(seed: u64) -> PointCloud {
+    let (w, h) = (320u32, 240u32);
+    let f = (w as Real / 2.0) / (28.5 as Real).to_radians().tan();
+    let mut state = seed;
+    let pixels: Vec<Option<Point3>> = (0..h)
+        .flat_map(|row| (0..w).map(move |col| (row, col)))
+        .map(|(row, col)| {
+            // Camera frame: x right, y down, z forward; the wall is z = 3 + x.
+            let d = Vector3::new(
+                (col as Real + 0.5 - w as Real / 2.0) / f,
+                (row as Real + 0.5 - h as Real / 2.0) / f,
+                1.0,
+            );
+            let z = 3.0 / (1.0 - d.x);
+            let (u1, u2) = (uniform(&mut state).max(1e-12), uniform(&mut state));
+            let gauss = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+            let noisy = z + gauss * (0.0012 + 0.0019 * z * z);
+            let step = 0.00285 * z * z;
+            let quantised = (noisy / step).round() * step;
+            Some(Point3::from(d * quantised))
+        })
+        .collect();
+    PointCloud::from_pixels(w, h, pixels).unwrap()
+}
+
+#[test]
+fn structured_light_frames_keep_a_far_wall_whole_where_the_range_camera_preset_fragments_it() {
+    let cloud = kinect_wall(7);
+    let largest_share = |seg: &Segmentation| {
+        let largest = seg.regions.iter().map(|r| r.points.len()).max().unwrap_or(0);
+        largest as Real / cloud.len() as Real
+    };
+    let light = segment(&cloud, &SegmentConfig::structured_light()).unwrap();
+    check_invariants(&cloud, &light, SegmentConfig::structured_light().min_region_size);
+    assert!(largest_share(&light) > 0.9, "{} regions", light.regions.len());
+    for r in &light.regions {
+        let n = r.plane.normal;
+        assert!((n.x.abs() - n.z.abs()).abs() < 0.05 && n.y.abs() < 0.05, "tilted: {n:?}");
+    }
+    let tof = segment(&cloud, &SegmentConfig::range_camera()).unwrap();
+    assert!(
+        tof.regions.len() > light.regions.len() && largest_share(&tof) < largest_share(&light),
+        "range camera: {} regions, largest {:.2}; structured light: {} regions, largest {:.2}",
+        tof.regions.len(),
+        largest_share(&tof),
+        light.regions.len(),
+        largest_share(&light)
+    );
+}

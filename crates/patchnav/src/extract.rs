@@ -45,8 +45,27 @@ pub enum SensorPreset {
     Alrf,
     /// Time-of-flight range camera (SR-3000-like).
     RangeCamera,
+    /// Structured-light depth camera (Kinect-like): noise growing with the square of the range.
+    StructuredLight,
     /// Noise-free synthetic scans.
     Exact,
+}
+
+impl SensorPreset {
+    /// The extraction pipeline's thresholds and the trimesh growing of the remainder for this
+    /// sensor.
+    pub fn configs(self) -> (PipelineConfig, TrimeshGrowConfig) {
+        match self {
+            SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
+            SensorPreset::RangeCamera => {
+                (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
+            }
+            SensorPreset::StructuredLight => {
+                (PipelineConfig::structured_light(), TrimeshGrowConfig::range_camera())
+            }
+            SensorPreset::Exact => (PipelineConfig::exact(), TrimeshGrowConfig::range_camera()),
+        }
+    }
 }
 
 /// Arguments of `patchnav extract`.
@@ -91,13 +110,7 @@ pub struct ExtractArgs {
 }
 
 fn config(args: &ExtractArgs) -> PipelineConfig {
-    let (mut config, grow) = match args.sensor {
-        SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
-        SensorPreset::RangeCamera => {
-            (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
-        }
-        SensorPreset::Exact => (PipelineConfig::exact(), TrimeshGrowConfig::range_camera()),
-    };
+    let (mut config, grow) = args.sensor.configs();
     if args.hybrid {
         config.remainder = Some(grow);
     }
@@ -297,6 +310,7 @@ fn sensor_name(sensor: SensorPreset) -> &'static str {
     match sensor {
         SensorPreset::Alrf => "alrf",
         SensorPreset::RangeCamera => "range-camera",
+        SensorPreset::StructuredLight => "structured-light",
         SensorPreset::Exact => "exact",
     }
 }

@@ -62,7 +62,15 @@ enum RealSource {
 struct RealFrame {
     name: &'static str,
     source: RealSource,
+    /// Our extraction preset for the frame's sensor (`patchnav extract --sensor`).
+    sensor: &'static str,
 }
+
+/// Our preset for depth from disparity (structured light, stereo): noise growing with the
+/// square of the range.
+const DISPARITY: &str = "structured-light";
+/// Our preset for time-of-flight frames (and the synthetic inputs): constant noise.
+const TIME_OF_FLIGHT: &str = "range-camera";
 
 /// The real organised frames: every organised depth or ToF frame of the real-data folder but
 /// two of the three nearly identical OpenNI box frames (0.25 s apart).
@@ -70,6 +78,7 @@ const REAL_FRAMES: [RealFrame; 5] = [
     RealFrame {
         name: "kinect-office",
         source: RealSource::Cloud { file: "pcl_kinect_office/office1.pcd", depth_camera: None },
+        sensor: DISPARITY,
     },
     RealFrame {
         name: "tum-desk",
@@ -77,6 +86,7 @@ const REAL_FRAMES: [RealFrame; 5] = [
             file: "tum_rgbd_kinect_frame/TUM_depth.png",
             depth_camera: Some("tum"),
         },
+        sensor: DISPARITY,
     },
     RealFrame {
         name: "openni-boxes",
@@ -84,6 +94,7 @@ const REAL_FRAMES: [RealFrame; 5] = [
             file: "pcl_openni_grabber_boxes/frame_20121214T142255.814212.pcd",
             depth_camera: None,
         },
+        sensor: DISPARITY,
     },
     RealFrame {
         name: "stereo-table-mug",
@@ -91,6 +102,7 @@ const REAL_FRAMES: [RealFrame; 5] = [
             file: "pcl_stereo_table_mug/table_scene_mug_stereo_textured.pcd",
             depth_camera: None,
         },
+        sensor: DISPARITY,
     },
     RealFrame {
         name: "ifm-o3r-tof",
@@ -99,6 +111,7 @@ const REAL_FRAMES: [RealFrame; 5] = [
             amplitude: "ifm_o3r_tof_frame/normalized_amplitude_u16.png",
             meta: "ifm_o3r_tof_frame/frame_meta.json",
         },
+        sensor: TIME_OF_FLIGHT,
     },
 ];
 
@@ -166,6 +179,8 @@ struct Input {
     set: Set,
     cloud: PathBuf,
     scoring: Scoring,
+    /// Our extraction preset.
+    sensor: &'static str,
 }
 
 /// Runs both sides [`REPS`] times on every input; returns the rows and the tables.
@@ -188,6 +203,7 @@ pub(crate) fn run_with(env: &Env, options: &Options) -> Result<(Vec<Value>, Stri
         set: Set::FloorPlan,
         cloud: scan,
         scoring: Scoring::FloorPlan,
+        sensor: TIME_OF_FLIGHT,
     }];
     let (lab_truth, lab) = lab_inputs(options.lab_frames, &dir.join("lab"))?;
     inputs.extend(lab);
@@ -249,7 +265,7 @@ fn run_side(env: &Env, dir: &Path, input: &Input, side: &str) -> Result<(Value, 
             "extract",
             &arg(&input.cloud),
             "--sensor",
-            "range-camera",
+            input.sensor,
             "--jsonl",
             &arg(&jsonl),
             "--polygons",
@@ -305,6 +321,7 @@ fn lab_inputs(frames: usize, dir: &Path) -> Result<(truth::SceneTruth, Vec<Input
             set: Set::Lab,
             cloud,
             scoring: Scoring::Lab(truth.visible(&labels)),
+            sensor: TIME_OF_FLIGHT,
         })
         .collect();
     Ok((truth, inputs))
@@ -387,6 +404,7 @@ fn real_inputs(env: &Env, real: &Path, dir: &Path, notes: &mut Vec<String>) -> R
             set: Set::Real,
             cloud: ply,
             scoring: Scoring::Coverage,
+            sensor: frame.sensor,
         });
     }
     Ok(inputs)

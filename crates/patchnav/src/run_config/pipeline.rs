@@ -61,13 +61,7 @@ enum Source {
 
 /// The extraction thresholds of a preset (as `patchnav extract --sensor`).
 fn presets(sensor: SensorPreset) -> (PipelineConfig, TrimeshGrowConfig) {
-    match sensor {
-        SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
-        SensorPreset::RangeCamera => {
-            (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
-        }
-        SensorPreset::Exact => (PipelineConfig::exact(), TrimeshGrowConfig::range_camera()),
-    }
+    sensor.configs()
 }
 
 /// The patches of a map type from scans (thesis §6.1): planes by the extraction pipeline, hybrid
