@@ -32,12 +32,12 @@ use std::process::Command;
 use std::time::Instant;
 
 /// Points within this distance of a mesh triangle are on it (metres).
-const ON_SURFACE: f64 = 0.02;
+pub(crate) const ON_SURFACE: f64 = 0.02;
 /// A true plane is visible with at least this many points on it (PCL's `min_inliers`).
-const VISIBLE_POINTS: usize = 500;
+pub(crate) const VISIBLE_POINTS: usize = 500;
 /// An extracted plane matches a true plane within these (degrees, metres).
-const MATCH_ANGLE_DEG: f64 = 2.0;
-const MATCH_OFFSET: f64 = 0.02;
+pub(crate) const MATCH_ANGLE_DEG: f64 = 2.0;
+pub(crate) const MATCH_OFFSET: f64 = 0.02;
 /// `floorplan.ply` moved so that its frame's origin is the floor plan's start point, with that
 /// move as its `sensor_to_world`: the same world points, but a viewpoint for our sensor-centred
 /// segmentation (which otherwise takes the world origin, a corner of the floor, as the sensor).
@@ -420,8 +420,7 @@ impl Truth {
     pub(crate) fn quality(&self, cloud: &str, polygons: &Value) -> Value {
         let planes = polygons.get("planes").and_then(Value::as_array).cloned().unwrap_or_default();
         let visible = self.visible(cloud);
-        let mut found = vec![false; self.planes.len()];
-        let (mut off, mut vertices, mut on_surface) = (0, 0, 0);
+        let mut tally = MatchTally::new(self.planes.len());
         for p in &planes {
             let num = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
             let n = p.get("normal").and_then(Value::as_array).cloned().unwrap_or_default();
@@ -444,10 +443,7 @@ impl Truth {
                         v.get(1).map_or(f64::NAN, num),
                         v.get(2).map_or(f64::NAN, num),
                     );
-                    vertices += 1;
-                    if self.nearest(&q).is_some() {
-                        on_surface += 1;
-                    }
+                    tally.vertex(self.nearest(&q).is_some());
                     corners.push(q);
                 }
             }
@@ -468,35 +464,14 @@ impl Truth {
                     .collect(),
                 _ => Vec::new(),
             };
-            if matched.is_empty() {
-                off += 1;
-            }
-            for i in matched {
-                found[i] = true;
-            }
+            tally.plane(matched);
         }
-        let missed: Vec<String> = visible
-            .iter()
-            .filter(|&&i| !found[i])
-            .map(|&i| {
-                let t = &self.planes[i];
-                format!(
-                    "n ({:.0} {:.0} {:.0}) · x = {:.2}",
-                    t.normal.x, t.normal.y, t.normal.z, t.offset
-                )
-            })
-            .collect();
-        let found = visible.iter().filter(|&&i| found[i]).count();
-        json!({
-            "true_planes_missed": missed,
-            "true_planes_visible": visible.len(),
-            "true_planes_found": found,
-            "planes_off_truth": off,
-            "polygon_vertices_checked": vertices,
-            "vertices_on_surface": if vertices > 0 { json!(on_surface as f64 / vertices as f64) } else { Value::Null },
-            "match_angle_deg": MATCH_ANGLE_DEG,
-            "match_offset_m": MATCH_OFFSET,
-            "on_surface_m": ON_SURFACE,
+        tally.report(visible, |i| {
+            let t = &self.planes[i];
+            format!(
+                "n ({:.0} {:.0} {:.0}) · x = {:.2}",
+                t.normal.x, t.normal.y, t.normal.z, t.offset
+            )
         })
     }
 }
@@ -638,6 +613,62 @@ fn table(rows: &[Value], truth: &Truth) -> String {
         }
     }
     out
+}
+
+/// The tally of one run's plane polygons against the true planes, shared by every scorer of
+/// extracted planes (`peers planes` here, `compare segmentation`'s lab truth): which true
+/// planes some polygon matched, the polygons that matched none, and the polygon vertices on a
+/// true surface.
+pub(crate) struct MatchTally {
+    found: Vec<bool>,
+    off: usize,
+    vertices: usize,
+    on_surface: usize,
+}
+
+impl MatchTally {
+    /// A tally over `true_planes` true planes.
+    pub(crate) fn new(true_planes: usize) -> MatchTally {
+        MatchTally { found: vec![false; true_planes], off: 0, vertices: 0, on_surface: 0 }
+    }
+
+    /// One polygon vertex, on a true surface or not.
+    pub(crate) fn vertex(&mut self, on_surface: bool) {
+        self.vertices += 1;
+        self.on_surface += usize::from(on_surface);
+    }
+
+    /// One extracted plane and the true planes it matches (none: off truth).
+    pub(crate) fn plane(&mut self, matched: Vec<usize>) {
+        if matched.is_empty() {
+            self.off += 1;
+        }
+        for i in matched {
+            if let Some(f) = self.found.get_mut(i) {
+                *f = true;
+            }
+        }
+    }
+
+    /// The quality JSON (the keys of the shared results rows): `visible` true planes, found,
+    /// missed (each described by `describe`), off truth, vertices on a surface.
+    pub(crate) fn report(&self, visible: &[usize], describe: impl Fn(usize) -> String) -> Value {
+        let found = |i: usize| self.found.get(i).copied().unwrap_or(false);
+        let missed: Vec<String> =
+            visible.iter().filter(|&&i| !found(i)).map(|&i| describe(i)).collect();
+        let vertices = self.vertices;
+        json!({
+            "true_planes_missed": missed,
+            "true_planes_visible": visible.len(),
+            "true_planes_found": visible.iter().filter(|&&i| found(i)).count(),
+            "planes_off_truth": self.off,
+            "polygon_vertices_checked": vertices,
+            "vertices_on_surface": if vertices > 0 { json!(self.on_surface as f64 / vertices as f64) } else { Value::Null },
+            "match_angle_deg": MATCH_ANGLE_DEG,
+            "match_offset_m": MATCH_OFFSET,
+            "on_surface_m": ON_SURFACE,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -312,7 +312,7 @@ fn run_with(
         );
         eprint!("{table}");
         eprintln!("thesis Table {number}:");
-        eprint!("{}", thesis_volume_table(thesis_rows));
+        eprint!("{}", thesis::volume_table_markdown(thesis_rows));
     }
     eprintln!("lab-volume: done in {:.1} s", t0.elapsed().as_secs_f64());
     Ok(())
@@ -609,20 +609,6 @@ fn contents_table(maps: &[LabMap]) -> String {
         );
     }
     o
-}
-
-/// A thesis volume table (Tables 6.2, 6.4) in the layout of [`CongruenceTable`]'s display.
-fn thesis_volume_table(rows: &[thesis::VolumeRow]) -> String {
-    let mut out = format!("| Map | Volume [m³] | {} |\n", thesis::LAB_MAPS.join(" | "));
-    for r in rows {
-        let cells: Vec<String> = r
-            .not_in_percent
-            .iter()
-            .map(|c| c.map_or("–".to_owned(), |p| format!("{p:.3}")))
-            .collect();
-        let _ = writeln!(out, "| {} | {} | {} |", r.map, r.volume_m3, cells.join(" | "));
-    }
-    out
 }
 
 #[cfg(test)]

@@ -378,8 +378,51 @@ pub const FIG_6_4_PATCH_MAPS_BELOW_S: f64 = 0.4;
 /// point-cloud maps, s (a lower bound).
 pub const FIG_6_4_SLOW_MAPS_ABOVE_S: f64 = 4.0;
 
+/// A count as the thesis prints it: thousands separated by commas from 10,000 on ("5906",
+/// "86,174", "5,600,612").
+pub fn count_text(n: u64) -> String {
+    let digits = n.to_string();
+    if digits.len() < 5 {
+        return digits;
+    }
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Tables 6.2 and 6.4 as Markdown, in the layout of `roadmap::volume::CongruenceTable`'s
+/// display: map, volume, then % not explored per column of [`LAB_MAPS`] ("–" on the diagonal).
+pub fn volume_table_markdown(rows: &[VolumeRow]) -> String {
+    let mut out = format!("| Map | Volume [m³] | {} |\n", LAB_MAPS.join(" | "));
+    out.push_str(&format!("|---|---|{}\n", "---|".repeat(LAB_MAPS.len())));
+    for r in rows {
+        let cells: Vec<String> = r
+            .not_in_percent
+            .iter()
+            .map(|c| c.map_or("–".to_owned(), |p| format!("{p:.3}")))
+            .collect();
+        out.push_str(&format!("| {} | {} | {} |\n", r.map, r.volume_m3, cells.join(" | ")));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn counts_and_volume_tables_print_as_the_thesis_prints_them() {
+        assert_eq!(count_text(5906), "5906");
+        assert_eq!(count_text(17_273), "17,273");
+        assert_eq!(count_text(5_600_612), "5,600,612");
+        let t = volume_table_markdown(&TABLE_6_2_RRT);
+        assert_eq!(t.lines().count(), 2 + TABLE_6_2_RRT.len());
+        assert!(t.contains("| planes | 9714.015 | – | 0.557 | 1.739 | 0.986 |"), "{t}");
+    }
+
     use super::*;
 
     const MEDIANS: [OfficeTable<f64>; 3] = [TABLE_5_3, TABLE_5_5, TABLE_5_10];

@@ -132,23 +132,13 @@ pub(super) fn volume_section(rows: &[Value]) -> String {
     o
 }
 
-/// A count as the thesis prints it: thousands separated from 10,000 on ("5906", "86,174").
+/// A count as the thesis prints it ([`thesis::count_text`]); a negative or non-finite value as
+/// it is.
 fn count_text(n: f64) -> String {
     if !(n.is_finite() && n >= 0.0) {
         return format!("{n}");
     }
-    let digits = format!("{:.0}", n.round());
-    if digits.len() < 5 {
-        return digits;
-    }
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
+    thesis::count_text(n.round() as u64)
 }
 
 /// Megabytes with three significant digits.

@@ -727,7 +727,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     )?;
     write!(out, "{rrt}")?;
     writeln!(out, "thesis Table 6.2 (RRT, Lab, 480 RRTs per map, K = 10,000, 1024³ × 38.684 mm):")?;
-    write!(out, "{}", thesis_volume_table(&thesis::TABLE_6_2_RRT))?;
+    write!(out, "{}", thesis::volume_table_markdown(&thesis::TABLE_6_2_RRT))?;
     writeln!(
         out,
         "\nTable 6.4 analogue: PRM explored volume [m³] and % not in, {} seeds, K = {prm_k}",
@@ -735,7 +735,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     )?;
     write!(out, "{prm}")?;
     writeln!(out, "thesis Table 6.4 (PRM, Lab):")?;
-    write!(out, "{}", thesis_volume_table(&thesis::TABLE_6_4_PRM))?;
+    write!(out, "{}", thesis::volume_table_markdown(&thesis::TABLE_6_4_PRM))?;
     writeln!(
         out,
         "\nThe thesis's volumes are of its own maps' boxes (objects seen through windows \
@@ -746,36 +746,9 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// A count of Table 6.1: "–" for none, thousands separated from 10,000 on ("5906", "17,273").
+/// A count of Table 6.1 as the thesis prints it; "–" for none.
 fn thesis_count(n: Option<u32>) -> String {
-    let Some(n) = n else { return "–".to_owned() };
-    if n < 10_000 {
-        return n.to_string();
-    }
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
-/// A thesis table of explored volumes (Tables 6.2, 6.4) as a Markdown table.
-fn thesis_volume_table(rows: &[thesis::VolumeRow]) -> String {
-    let mut out = format!("| Map | Volume [m³] | {} |\n", thesis::LAB_MAPS.join(" | "));
-    out.push_str("|---|---|---|---|---|---|\n");
-    for r in rows {
-        let cells: Vec<String> = r
-            .not_in_percent
-            .iter()
-            .map(|c| c.map_or("–".to_owned(), |p| format!("{p:.3}")))
-            .collect();
-        let _ = writeln!(out, "| {} | {} | {} |", r.map, r.volume_m3, cells.join(" | "));
-    }
-    out
+    n.map_or("–".to_owned(), |n| thesis::count_text(n.into()))
 }
 
 #[cfg(test)]
@@ -816,10 +789,10 @@ mod tests {
         assert_eq!(thesis_count(Some(5906)), "5906");
         assert_eq!(thesis_count(Some(5_600_612)), "5,600,612");
         assert_eq!(thesis_count(None), "–");
-        let rrt = thesis_volume_table(&thesis::TABLE_6_2_RRT);
+        let rrt = thesis::volume_table_markdown(&thesis::TABLE_6_2_RRT);
         assert!(rrt.starts_with("| Map | Volume [m³] | planes | hybrid | trimesh | pc |"), "{rrt}");
         assert!(rrt.contains("| planes | 9714.015 | – | 0.557 | 1.739 | 0.986 |"), "{rrt}");
-        let prm = thesis_volume_table(&thesis::TABLE_6_4_PRM);
+        let prm = thesis::volume_table_markdown(&thesis::TABLE_6_4_PRM);
         assert!(prm.contains("| hybrid | 11841.7095 | 0.008 | – | 0.593 | 0.251 |"), "{prm}");
     }
 

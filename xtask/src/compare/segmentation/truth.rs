@@ -18,16 +18,11 @@
 
 use pointcloud::{Point3, Vector3};
 use scene_sim::{Point2, Scene, Shape};
-use serde_json::{Value, json};
+use serde_json::Value;
 
-/// Points within this distance of a surface are on it (metres).
-pub(crate) const ON_SURFACE: f64 = 0.02;
-/// A true plane is visible with at least this many measured pixels on it (PCL's `min_inliers`).
-pub(crate) const VISIBLE_POINTS: usize = 500;
-/// An extracted plane matches a true plane within these (degrees, metres).
-pub(crate) const MATCH_ANGLE_DEG: f64 = 2.0;
-/// See [`MATCH_ANGLE_DEG`].
-pub(crate) const MATCH_OFFSET: f64 = 0.02;
+use crate::peers::MatchTally;
+pub(crate) use crate::peers::{MATCH_ANGLE_DEG, MATCH_OFFSET, ON_SURFACE, VISIBLE_POINTS};
+
 /// Surfaces lie on one true plane within these (degrees, metres).
 const SAME_PLANE_DEG: f64 = 1.0;
 const SAME_PLANE_M: f64 = 0.01;
@@ -165,11 +160,11 @@ impl SceneTruth {
     /// The quality of a run's plane polygons with `visible` true planes, as the JSON object
     /// `peers::Truth::quality` gives (the same keys).
     pub(crate) fn quality(&self, visible: &[usize], polygons: &Value) -> Value {
-        let mut found = vec![false; self.planes.len()];
-        let (mut off, mut vertices, mut on_surface) = (0usize, 0usize, 0usize);
+        let mut tally = MatchTally::new(self.planes.len());
         for e in parse_planes(polygons) {
-            vertices += e.corners.len();
-            on_surface += e.corners.iter().filter(|q| self.on_surface(q)).count();
+            for q in &e.corners {
+                tally.vertex(self.on_surface(q));
+            }
             let matched: Vec<usize> = match e.plane {
                 Some(plane) if !e.corners.is_empty() => (0..self.planes.len())
                     .filter(|&i| {
@@ -181,35 +176,14 @@ impl SceneTruth {
                     .collect(),
                 _ => Vec::new(),
             };
-            if matched.is_empty() {
-                off += 1;
-            }
-            for i in matched {
-                found[i] = true;
-            }
+            tally.plane(matched);
         }
-        let missed: Vec<String> = visible
-            .iter()
-            .filter(|&&i| !found.get(i).copied().unwrap_or(false))
-            .filter_map(|&i| self.planes.get(i))
-            .map(|t| {
-                format!(
-                    "n ({:.2} {:.2} {:.2}) · x = {:.2}",
-                    t.normal.x, t.normal.y, t.normal.z, t.offset
-                )
-            })
-            .collect();
-        let found = visible.iter().filter(|&&i| found.get(i).copied().unwrap_or(false)).count();
-        json!({
-            "true_planes_missed": missed,
-            "true_planes_visible": visible.len(),
-            "true_planes_found": found,
-            "planes_off_truth": off,
-            "polygon_vertices_checked": vertices,
-            "vertices_on_surface": if vertices > 0 { json!(on_surface as f64 / vertices as f64) } else { Value::Null },
-            "match_angle_deg": MATCH_ANGLE_DEG,
-            "match_offset_m": MATCH_OFFSET,
-            "on_surface_m": ON_SURFACE,
+        tally.report(visible, |i| {
+            let t = &self.planes[i];
+            format!(
+                "n ({:.2} {:.2} {:.2}) · x = {:.2}",
+                t.normal.x, t.normal.y, t.normal.z, t.offset
+            )
         })
     }
 }
@@ -266,6 +240,7 @@ mod tests {
     use super::*;
     use pointcloud::Isometry3;
     use scene_sim::{Cuboid, Cylinder, Material, PlanarPolygon, SceneBuilder, Sphere};
+    use serde_json::json;
 
     /// A floor (10 × 10 m at z = 0), a 1 m box standing on it at (5, 5), a sphere and a
     /// cylinder.
