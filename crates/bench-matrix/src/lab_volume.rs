@@ -51,6 +51,7 @@
 //! `starts`, `k`, `runs`, `radius`, the RRT's `step` or the PRM's `neighbours`, and `lab_maps`
 //! (the folder's name, which holds the build parameters).
 
+use crate::roadmap::lab_scene::near_corner;
 use crate::roadmap::{MatrixArgs, lab_maps};
 use anyhow::{Context, Result, bail};
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
@@ -384,16 +385,7 @@ pub(crate) fn corner_starts(
         .iter()
         .take(n)
         .map(|&(cx, cy, sx, sy)| {
-            (0..8)
-                .flat_map(|ring| {
-                    let d = 0.6 + 0.2 * Real::from(ring);
-                    (0..=ring).flat_map(move |k| {
-                        let e = 0.6 + 0.2 * Real::from(k);
-                        [(d, e), (e, d)]
-                    })
-                })
-                .map(|(dx, dy)| Point3::new(cx + sx * dx, cy + sy * dy, 1.0))
-                .find(|p| free(p))
+            near_corner(Point3::new(cx, cy, 1.0), [sx, sy], free)
                 .with_context(|| format!("no free start near the room corner ({cx}, {cy})"))
         })
         .collect()

@@ -49,7 +49,7 @@
 //! row records `jobs`, and timing tables should come from `--jobs 1`.
 
 pub(crate) mod lab_maps;
-mod lab_scene;
+pub(crate) mod lab_scene;
 mod planners;
 
 use anyhow::{Context, Result, bail};

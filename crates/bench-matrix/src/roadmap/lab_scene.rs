@@ -36,6 +36,19 @@ pub(crate) fn corner_start(
                 .iter()
                 .all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.is_step_free(&s)))
     };
+    near_corner(Point3::new(0.0, 0.0, 1.0), [1.0, 1.0], free)
+        .context("no free start near the lab's south-west corner")
+}
+
+/// The first point `free` accepts on a small spiral from 0.6 m inside a room corner at
+/// `corner` (its height kept), stepping 0.2 m into the room along `inwards` (±1 per axis):
+/// eight rings: the rule of every lab start here, and the one `patchnav experiment lab-timing`
+/// follows.
+pub(crate) fn near_corner(
+    corner: Point3,
+    inwards: [Real; 2],
+    free: impl Fn(&Point3) -> bool,
+) -> Option<Point3> {
     (0..8)
         .flat_map(|ring| {
             let d = 0.6 + 0.2 * Real::from(ring);
@@ -44,9 +57,10 @@ pub(crate) fn corner_start(
                 [(d, e), (e, d)]
             })
         })
-        .map(|(dx, dy)| Point3::new(dx, dy, 1.0))
+        .map(|(dx, dy)| {
+            Point3::new(corner.x + inwards[0] * dx, corner.y + inwards[1] * dy, corner.z)
+        })
         .find(|p| free(p))
-        .context("no free start near the lab's south-west corner")
 }
 
 #[cfg(test)]
