@@ -34,7 +34,7 @@
 pub(crate) mod explore;
 pub(crate) mod maps;
 pub(crate) mod planning;
-mod sensors;
+pub(crate) mod sensors;
 
 use super::model::{DemoResults, FileEntry, Scale, SceneInfo, StageTime};
 use crate::progress::Progress;

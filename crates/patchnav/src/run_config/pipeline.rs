@@ -10,12 +10,13 @@ use crate::demo::model::{
 };
 use crate::demo::pipeline::explore::{Exploration, ExplorePlanner, Target, explore};
 use crate::demo::pipeline::maps::{drawing, patch_mesh};
+use crate::demo::pipeline::planning::RunRecord;
 use crate::demo::pipeline::{
     Clock, Files, MAX_DRAWN, decimate, p3, p3mm, write_mesh_f32, write_ply_f32,
 };
 use crate::extract::SensorPreset;
 use crate::input::InputArgs;
-use crate::plan::{PlannerChoice, make_planner, write_obj_paths, write_obj_roadmap};
+use crate::plan::{PlannerChoice, make_planner};
 use crate::progress::Progress;
 use crate::scene_map::{
     MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map, planar_triangles,
@@ -28,9 +29,7 @@ use patch_map::{
     AnyMap, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh, sample_patch_points,
 };
 use pointcloud::{Aabb, PointCloud, SensorPose};
-use roadmap::metrics::upper_quartile;
 use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PlannerStatus, PlanningSpace, Problem};
-use sensor_tof::PixelOutcome;
 use std::path::Path;
 use std::time::Instant;
 
@@ -529,48 +528,20 @@ fn plan(
                 if status == PlannerStatus::InvalidStart {
                     bail!("plan.start is not a valid start on the {} map ({})", m.kind, run.name());
                 }
-                let crate::demo::pipeline::planning::RunGeometry { paths, metrics, angles, edges } =
-                    crate::demo::pipeline::planning::RunGeometry::of(
-                        run.as_ref(),
-                        problem.goals.len(),
-                    );
-                let graph = run.roadmap();
                 let name = choice.cli_name();
-                if k == 0 && config.write_3d {
-                    let tag = format!("{}-{name}", maps.name(m));
-                    let file = format!("roadmap-{tag}.obj");
-                    write_obj_roadmap(&files.path(&file), graph)?;
-                    files.add(
-                        format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
-                        &file,
-                    )?;
-                    let file = format!("path-{tag}.obj");
-                    write_obj_paths(&files.path(&file), &paths)?;
-                    files.add(
-                        format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
-                        &file,
-                    )?;
-                }
-                let c = run.counters();
-                runs.push(PlanRun {
-                    map: m.kind.name().to_owned(),
-                    backend: m.map.backend().to_owned(),
-                    planner: name,
+                let record = RunRecord {
+                    kind: m.kind,
+                    map: &m.map,
+                    drawn: k == 0,
+                    obj_tag: (k == 0 && config.write_3d)
+                        .then(|| format!("{}-{name}", maps.name(m))),
+                    name,
                     seed,
-                    solved: paths.len() == problem.goals.len(),
                     seconds,
-                    iterations: c.samples,
-                    vertices: c.vertices,
-                    collision_checks: c.collision_checks,
-                    path_length: metrics.iter().map(|m| m.length).sum(),
-                    turns: metrics.iter().map(|m| m.turns).sum(),
-                    steep_turns: metrics.iter().map(|m| m.steep_turns).sum(),
-                    curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
-                    start: p3(&p.start),
-                    goals: p.goals.iter().map(p3).collect(),
-                    paths: paths.iter().map(|q| q.iter().map(p3).collect()).collect(),
-                    edges: if k == 0 { decimate(&edges, MAX_DRAWN) } else { Vec::new() },
-                });
+                    start: p.start,
+                    goals: &p.goals,
+                };
+                runs.push(record.record(run.as_ref(), files)?);
                 bar.inc(1);
             }
         }
@@ -615,17 +586,7 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
     let (frame, out, name) = crate::tof::filter_frame(&args).context("[tof]")?;
     let millis = t0.elapsed().as_secs_f64() * 1e3;
     let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
-    let outcomes = out
-        .outcomes
-        .iter()
-        .zip(&measured)
-        .map(|(&o, &m)| match o {
-            PixelOutcome::Kept => 0,
-            PixelOutcome::Unwrapped => 1,
-            PixelOutcome::Dropped if m => 2,
-            PixelOutcome::Dropped => 3,
-        })
-        .collect();
+    let outcomes = crate::demo::pipeline::sensors::outcome_codes(&out.outcomes, &measured);
     if write_3d {
         let cloud = out.to_cloud(&frame, false);
         pointcloud::io::write_cloud(&args.out, &cloud)?;

@@ -110,32 +110,81 @@ pub(super) fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, V
     Ok((*start, goals))
 }
 
-/// What a finished run found: its paths to the goals it reached, their metrics, all turn
-/// angles, and its roadmap's edges (millimetre-rounded, for the pictures).
-pub(crate) struct RunGeometry {
-    /// One path per reached goal.
-    pub(crate) paths: Vec<Vec<Point3>>,
-    /// The metrics of each path.
-    pub(crate) metrics: Vec<PathMetrics>,
-    /// Every turn angle of every path.
-    pub(crate) angles: Vec<f64>,
-    /// The roadmap's edges.
-    pub(crate) edges: Vec<[[f64; 3]; 2]>,
+/// One finished planning run as the report keeps it ([`PlanRun`]): its paths to the goals it
+/// reached with their metrics (thesis §5.6), counters, and ([`drawn`](Self::drawn)) its
+/// roadmap's edges for the pictures; optionally the roadmap and paths written as OBJ under
+/// `files` (`roadmap-<tag>.obj`, `path-<tag>.obj`). Shared by the demo and `patchnav run`.
+pub(crate) struct RunRecord<'a> {
+    /// The type of the map planned on.
+    pub(crate) kind: MapKind,
+    /// The map planned on.
+    pub(crate) map: &'a AnyMap,
+    /// The planner's name in the report.
+    pub(crate) name: String,
+    /// The run's seed.
+    pub(crate) seed: u64,
+    /// Wall time of `solve`.
+    pub(crate) seconds: f64,
+    /// The start.
+    pub(crate) start: Point3,
+    /// The goal centres.
+    pub(crate) goals: &'a [Point3],
+    /// Keep the roadmap's edges (decimated) for the pictures.
+    pub(crate) drawn: bool,
+    /// Write the roadmap and the paths as OBJ files under this tag.
+    pub(crate) obj_tag: Option<String>,
 }
 
-impl RunGeometry {
-    /// Of `run`, which had `goals` goals.
-    pub(crate) fn of(run: &dyn Planner, goals: usize) -> RunGeometry {
-        let paths: Vec<Vec<Point3>> = (0..goals).filter_map(|g| run.path_to(g)).collect();
-        let metrics = paths.iter().map(|p| PathMetrics::of(p)).collect();
-        let angles = paths.iter().flat_map(|p| turn_angles(p)).collect();
+impl RunRecord<'_> {
+    /// The [`PlanRun`] of `run`; writes its OBJ files when [`obj_tag`](Self::obj_tag) is set.
+    pub(crate) fn record(self, run: &dyn Planner, files: &mut Files) -> Result<PlanRun> {
+        let paths: Vec<Vec<Point3>> =
+            (0..self.goals.len()).filter_map(|g| run.path_to(g)).collect();
+        let metrics: Vec<PathMetrics> = paths.iter().map(|p| PathMetrics::of(p)).collect();
+        let angles: Vec<f64> = paths.iter().flat_map(|p| turn_angles(p)).collect();
         let graph = run.roadmap();
-        let edges = graph
-            .edge_indices()
-            .filter_map(|e| graph.edge_endpoints(e))
-            .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
-            .collect();
-        RunGeometry { paths, metrics, angles, edges }
+        let (kind, name) = (self.kind, &self.name);
+        if let Some(tag) = &self.obj_tag {
+            let file = format!("roadmap-{tag}.obj");
+            write_obj_roadmap(&files.path(&file), graph)?;
+            files.add(format!("{name} roadmap on the {kind} map (OBJ polylines)"), &file)?;
+            let file = format!("path-{tag}.obj");
+            write_obj_paths(&files.path(&file), &paths)?;
+            files.add(
+                format!("{name} paths on the {kind} map, one polyline per goal (OBJ)"),
+                &file,
+            )?;
+        }
+        let edges = if self.drawn {
+            let edges: Vec<[[f64; 3]; 2]> = graph
+                .edge_indices()
+                .filter_map(|e| graph.edge_endpoints(e))
+                .map(|(a, b)| [p3mm(&graph[a]), p3mm(&graph[b])])
+                .collect();
+            decimate(&edges, MAX_DRAWN)
+        } else {
+            Vec::new()
+        };
+        let c = run.counters();
+        Ok(PlanRun {
+            map: kind.name().to_owned(),
+            backend: self.map.backend().to_owned(),
+            planner: self.name,
+            seed: self.seed,
+            solved: paths.len() == self.goals.len(),
+            seconds: self.seconds,
+            iterations: c.samples,
+            vertices: c.vertices,
+            collision_checks: c.collision_checks,
+            path_length: metrics.iter().map(|m| m.length).sum(),
+            turns: metrics.iter().map(|m| m.turns).sum(),
+            steep_turns: metrics.iter().map(|m| m.steep_turns).sum(),
+            curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
+            start: p3(&self.start),
+            goals: self.goals.iter().map(p3).collect(),
+            paths: paths.iter().map(|p| p.iter().map(p3).collect()).collect(),
+            edges,
+        })
     }
 }
 
@@ -179,44 +228,19 @@ pub(super) fn plan_all(
                 if status == PlannerStatus::InvalidStart {
                     bail!("the start is not free on the {} map", m.kind);
                 }
-                let RunGeometry { paths, metrics, angles, edges } =
-                    RunGeometry::of(run.as_ref(), problem.goals.len());
-                let graph = run.roadmap();
-                let c = run.counters();
                 let name = run.name().to_owned();
-                if s == 0 {
-                    let file = format!("roadmap-{}-{name}.obj", m.kind);
-                    write_obj_roadmap(&files.path(&file), graph)?;
-                    files.add(
-                        format!("{name} roadmap on the {} map (OBJ polylines)", m.kind),
-                        &file,
-                    )?;
-                    let file = format!("path-{}-{name}.obj", m.kind);
-                    write_obj_paths(&files.path(&file), &paths)?;
-                    files.add(
-                        format!("{name} paths on the {} map, one polyline per goal (OBJ)", m.kind),
-                        &file,
-                    )?;
-                }
-                runs.push(PlanRun {
-                    map: m.kind.name().to_owned(),
-                    backend: m.map.backend().to_owned(),
-                    planner: name,
+                let record = RunRecord {
+                    kind: m.kind,
+                    map: &m.map,
+                    drawn: s == 0,
+                    obj_tag: (s == 0).then(|| format!("{}-{name}", m.kind)),
+                    name,
                     seed: run_seed,
-                    solved: paths.len() == problem.goals.len(),
                     seconds,
-                    iterations: c.samples,
-                    vertices: c.vertices,
-                    collision_checks: c.collision_checks,
-                    path_length: metrics.iter().map(|m| m.length).sum(),
-                    turns: metrics.iter().map(|m| m.turns).sum(),
-                    steep_turns: metrics.iter().map(|m| m.steep_turns).sum(),
-                    curviness_deg: upper_quartile(&angles).unwrap_or(0.0).to_degrees(),
-                    start: p3(start),
-                    goals: goal_points.iter().map(p3).collect(),
-                    paths: paths.iter().map(|p| p.iter().map(p3).collect()).collect(),
-                    edges: if s == 0 { decimate(&edges, MAX_DRAWN) } else { Vec::new() },
-                });
+                    start: *start,
+                    goals: &goal_points,
+                };
+                runs.push(record.record(run.as_ref(), files)?);
                 bar.inc(1);
             }
         }

@@ -51,17 +51,7 @@ pub(super) fn tof(seed: u64, files: &mut Files) -> Result<TofSection> {
     let millis = t0.elapsed().as_secs_f64() * 1e3;
     let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
     let s = score(&out, &measured, &sim.truth, TOLERANCE_M)?;
-    let outcomes = out
-        .outcomes
-        .iter()
-        .zip(&measured)
-        .map(|(&o, &m)| match o {
-            PixelOutcome::Kept => 0,
-            PixelOutcome::Unwrapped => 1,
-            PixelOutcome::Dropped if m => 2,
-            PixelOutcome::Dropped => 3,
-        })
-        .collect();
+    let outcomes = outcome_codes(&out.outcomes, &measured);
     let wrapped = sim.truth.wraps.iter().filter(|&&w| w > 0).count();
     let mut cloud = out.to_cloud(frame, false);
     cloud.set_sensor_pose(Some(scene.pose));
@@ -147,4 +137,19 @@ pub(super) fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
         hough_png: png,
         sectors,
     })
+}
+
+/// The pixel outcomes as [`TofSection::outcomes`] stores them: 0 kept, 1 unwrapped, 2 dropped,
+/// 3 not measured (range 0) — shared by the demo and `patchnav run`.
+pub(crate) fn outcome_codes(outcomes: &[PixelOutcome], measured: &[bool]) -> Vec<u8> {
+    outcomes
+        .iter()
+        .zip(measured)
+        .map(|(&o, &m)| match o {
+            PixelOutcome::Kept => 0,
+            PixelOutcome::Unwrapped => 1,
+            PixelOutcome::Dropped if m => 2,
+            PixelOutcome::Dropped => 3,
+        })
+        .collect()
 }
