@@ -539,22 +539,11 @@ fn tables(rows: &[Value]) -> String {
              |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for i in &scored {
-            for (label, side) in [("PCL", &i.pcl), ("ours", &i.ours)] {
-                let Some(s) = side else { continue };
-                skipped.extend(s.skipped.iter().cloned());
-                if s.runs == 0 {
-                    continue;
-                }
+            for (label, s) in sides(i, &mut skipped) {
                 let _ = writeln!(
                     out,
-                    "| {} | {label} | {} | {} | {} | {} / {} / {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                    i.input,
-                    s.method,
-                    s.runs,
-                    num(s.time),
-                    num(s.normals),
-                    num(s.seg),
-                    num(s.hull),
+                    "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                    row_head(i, label, s),
                     s.count("planes"),
                     s.count("polygons"),
                     s.count("polygon_vertices"),
@@ -576,22 +565,11 @@ fn tables(rows: &[Value]) -> String {
              |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for i in &real {
-            for (label, side) in [("PCL", &i.pcl), ("ours", &i.ours)] {
-                let Some(s) = side else { continue };
-                skipped.extend(s.skipped.iter().cloned());
-                if s.runs == 0 {
-                    continue;
-                }
+            for (label, s) in sides(i, &mut skipped) {
                 let _ = writeln!(
                     out,
-                    "| {} | {label} | {} | {} | {} | {} / {} / {} | {} | {} | {} | {} | {} | {} | {} |",
-                    i.input,
-                    s.method,
-                    s.runs,
-                    num(s.time),
-                    num(s.normals),
-                    num(s.seg),
-                    num(s.hull),
+                    "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                    row_head(i, label, s),
                     s.count("points"),
                     s.count("planes"),
                     s.count("polygons"),
@@ -610,6 +588,33 @@ fn tables(rows: &[Value]) -> String {
         let _ = writeln!(out, "\nNote: {s}.");
     }
     out
+}
+
+/// The sides of `i` that ran (PCL, then ours), their skipped-run notes added to `skipped`.
+fn sides<'a>(i: &'a PerInput, skipped: &mut Vec<String>) -> Vec<(&'static str, &'a Side)> {
+    let mut out = Vec::new();
+    for (label, side) in [("PCL", &i.pcl), ("ours", &i.ours)] {
+        let Some(s) = side else { continue };
+        skipped.extend(s.skipped.iter().cloned());
+        if s.runs > 0 {
+            out.push((label, s));
+        }
+    }
+    out
+}
+
+/// The first columns of a side's row: input, side, method, runs, median time, stage times.
+fn row_head(i: &PerInput, label: &str, s: &Side) -> String {
+    format!(
+        "{} | {label} | {} | {} | {} | {} / {} / {}",
+        i.input,
+        s.method,
+        s.runs,
+        num(s.time),
+        num(s.normals),
+        num(s.seg),
+        num(s.hull)
+    )
 }
 
 fn ratio_of(i: &PerInput) -> String {
