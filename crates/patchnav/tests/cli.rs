@@ -1,33 +1,9 @@
 //! The command line as a user meets it: real processes, real files, exit codes and messages.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
-
-fn fixture(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
-    p.to_str().unwrap().to_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Asserts a failure reported as one `error:` line and exit code 1.
-fn assert_one_line_error(o: &Output, needle: &str) {
-    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
-    let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "one line expected, got: {err}");
-    assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(needle), "`{needle}` not in: {err}");
-}
+mod common;
+use common::*;
 
 #[test]
 fn info_describes_every_fixture_format() {

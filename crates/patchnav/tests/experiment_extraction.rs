@@ -2,12 +2,10 @@
 //! at 3°, a small camera, one map scan) and without real data.
 
 use std::collections::BTreeSet;
-use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
+mod common;
+use common::*;
 
 const QUICK: &[&str] = &["experiment", "extraction", "--quick", "--real", "/nonexistent"];
 

@@ -2,19 +2,9 @@
 //! sparse scan, a coarse trimesh, few iterations and a coarse voxel grid.
 
 use std::collections::BTreeMap;
-use std::process::{Command, Output};
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::*;
 
 /// Small maps: one ALRF scan at 2°, 0.5 m triangles.
 const TOY_MAPS: &[&str] =

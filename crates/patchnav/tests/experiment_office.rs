@@ -2,19 +2,9 @@
 //! room with four goals in the corners), so the test never depends on the shared benchmark.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::*;
 
 const START: [f64; 3] = [3.0, 3.0, 1.0];
 const GOALS: [[f64; 3]; 4] = [[1.0, 1.0, 1.0], [5.0, 1.0, 1.0], [1.0, 5.0, 1.0], [5.0, 5.0, 1.0]];

@@ -1,10 +1,7 @@
 //! `patchnav extract`: simulated scans in, a map file and an OBJ export out.
 
-use std::process::{Command, Output};
-
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
+mod common;
+use common::*;
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()

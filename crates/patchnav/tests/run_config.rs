@@ -3,24 +3,10 @@
 
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn fixture(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures").join(name);
-    p.to_str().unwrap().to_owned()
-}
+mod common;
+use common::*;
 
 /// Asserts a failure reported as one `error:` line and exit code 1.
 fn assert_one_line_error(o: &Output, needle: &str) {

@@ -4,19 +4,9 @@
 use pointcloud::{Point3, SensorPose};
 use scene_sim::{RangeCamera, RangeSensor, TerrainSpec, terrain};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::*;
 
 /// An SR-3000 frame of `spec` from a level camera 0.45 m above the floor, written as PLY.
 fn frame(dir: &Path, name: &str, spec: TerrainSpec) -> PathBuf {
@@ -85,15 +75,6 @@ fn hough_png_is_written() {
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
-}
-
-/// Asserts a failure reported as one `error:` line and exit code 1.
-fn assert_one_line_error(o: &Output, needle: &str) {
-    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
-    let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "one line expected, got: {err}");
-    assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(needle), "`{needle}` not in: {err}");
 }
 
 #[test]

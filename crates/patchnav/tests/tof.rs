@@ -10,11 +10,10 @@ use sensor_tof::{
     WhiteWallTable,
 };
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn patchnav(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_patchnav")).args(args).output().expect("patchnav runs")
-}
+mod common;
+use common::*;
 
 /// `patchnav tof filter --range R --amplitude A --meta M EXTRA...`.
 fn filter_cmd(range: &str, amplitude: &str, meta: &str, extra: &[&str]) -> Output {
@@ -24,25 +23,8 @@ fn filter_cmd(range: &str, amplitude: &str, meta: &str, extra: &[&str]) -> Outpu
     patchnav(&args)
 }
 
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// Asserts a failure reported as one `error:` line and exit code 1.
-fn assert_one_line_error(o: &Output, needle: &str) {
-    assert_eq!(o.status.code(), Some(1), "stderr: {}", stderr(o));
-    let err = stderr(o);
-    assert_eq!(err.lines().count(), 1, "one line expected, got: {err}");
-    assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(needle), "`{needle}` not in: {err}");
 }
 
 /// The SR-3000 seeing, left of column 88, a wall of reflectivity 0.5 at 3 m and, right of it, a
