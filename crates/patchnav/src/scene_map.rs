@@ -372,13 +372,20 @@ pub enum MapSource {
 /// The patches of map type `kind` extracted from `clouds` (see [`MapSource::Scans`]); `None`
 /// for the pc map.
 pub fn extracted_patches(clouds: &[PointCloud], kind: MapKind) -> Result<Option<Vec<Patch>>> {
-    let grow = TrimeshGrowConfig::alrf();
+    extracted_patches_with(clouds, kind, PipelineConfig::alrf(), TrimeshGrowConfig::alrf())
+}
+
+/// [`extracted_patches`] with the extraction thresholds `pipeline` and the trimesh growing
+/// `grow` of another sensor preset (`patchnav extract --sensor`).
+pub fn extracted_patches_with(
+    clouds: &[PointCloud],
+    kind: MapKind,
+    pipeline: PipelineConfig,
+    grow: TrimeshGrowConfig,
+) -> Result<Option<Vec<Patch>>> {
     Ok(match kind {
-        MapKind::Planes => Some(extract(clouds, &PipelineConfig::alrf(), |_| {})?.patches),
-        MapKind::Hybrid => {
-            let config = PipelineConfig::alrf().with_remainder(grow);
-            Some(extract(clouds, &config, |_| {})?.patches)
-        }
+        MapKind::Planes => Some(extract(clouds, &pipeline, |_| {})?.patches),
+        MapKind::Hybrid => Some(extract(clouds, &pipeline.with_remainder(grow), |_| {})?.patches),
         MapKind::Trimesh => {
             let mut patches = Vec::new();
             for cloud in clouds {

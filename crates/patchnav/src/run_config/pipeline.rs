@@ -23,8 +23,7 @@ use crate::scene_map::{
 };
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
-use patch_core::{CapsuleStep, Isometry3, Patch, Point3, UnspecificStepIntersector};
-use patch_extract::{PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes};
+use patch_core::{CapsuleStep, Patch, Point3, UnspecificStepIntersector};
 use patch_map::{
     AnyMap, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh, sample_patch_points,
 };
@@ -58,37 +57,12 @@ enum Source {
     Points(Vec<Point3>),
 }
 
-/// The extraction thresholds of a preset (as `patchnav extract --sensor`).
-fn presets(sensor: SensorPreset) -> (PipelineConfig, TrimeshGrowConfig) {
-    sensor.configs()
-}
-
-/// The patches of a map type from scans (thesis §6.1): planes by the extraction pipeline, hybrid
-/// with trimesh patches grown on the remainder, trimesh by naive trimesh growing on each scan
-/// (Alg. 4/5) moved into the world frame. For the ALRF preset this is
-/// [`crate::scene_map::extracted_patches`].
+/// The patches of a map type from scans (thesis §6.1), with the thresholds of `sensor`
+/// ([`crate::scene_map::extracted_patches_with`]).
 fn scan_patches(clouds: &[PointCloud], kind: MapKind, sensor: SensorPreset) -> Result<Vec<Patch>> {
-    let (pipeline, grow) = presets(sensor);
-    Ok(match kind {
-        MapKind::Planes => extract(clouds, &pipeline, |_| {})?.patches,
-        MapKind::Hybrid => extract(clouds, &pipeline.with_remainder(grow), |_| {})?.patches,
-        MapKind::Trimesh => {
-            let mut patches = Vec::new();
-            for cloud in clouds {
-                let motion =
-                    cloud.sensor_pose().map_or_else(Isometry3::identity, |p| p.world_from_sensor);
-                let grown = grow_trimeshes(cloud, &grow)?;
-                patches.extend(
-                    grown
-                        .into_patches()
-                        .into_iter()
-                        .map(|m| Patch::Trimesh(m.transformed(&motion))),
-                );
-            }
-            patches
-        }
-        MapKind::Pc => bail!("the pc map has no patches"),
-    })
+    let (pipeline, grow) = sensor.configs();
+    crate::scene_map::extracted_patches_with(clouds, kind, pipeline, grow)?
+        .context("the pc map has no patches")
 }
 
 /// The map type a map file holds: `pc` for points, else by its patches.
