@@ -9,11 +9,9 @@ use crate::demo::model::{
     VolumeSection,
 };
 use crate::demo::pipeline::explore::{Exploration, ExplorePlanner, Target, explore};
-use crate::demo::pipeline::maps::{drawing, patch_mesh};
+use crate::demo::pipeline::maps::{drawing, patch_mesh, point_map_entry};
 use crate::demo::pipeline::planning::RunRecord;
-use crate::demo::pipeline::{
-    Clock, Files, MAX_DRAWN, decimate, p3, p3mm, write_mesh_f32, write_ply_f32,
-};
+use crate::demo::pipeline::{Clock, Files, p3, write_mesh_f32, write_ply_f32};
 use crate::extract::SensorPreset;
 use crate::input::InputArgs;
 use crate::plan::{PlannerChoice, make_planner};
@@ -238,22 +236,9 @@ impl Maps {
             if points.is_empty() {
                 bail!("the pc map has no points");
             }
-            self.rows.push(MapRow {
-                kind: kind.name().to_owned(),
-                backend: map.backend().to_owned(),
-                planar_patches: 0,
-                trimesh_patches: 0,
-                triangles: 0,
-                points: points.len(),
-                memory_bytes: map.memory_bytes(),
-                file_bytes: map.save(std::io::sink())?,
-                build_seconds: seconds,
-            });
-            self.drawings.push(MapDrawing {
-                kind: kind.name().to_owned(),
-                points: decimate(&points, MAX_DRAWN).iter().map(p3mm).collect(),
-                ..MapDrawing::default()
-            });
+            let (row, drawing) = point_map_entry(&map, &points, seconds)?;
+            self.rows.push(row);
+            self.drawings.push(drawing);
             if write_3d {
                 let name = "map-pc.ply";
                 write_ply_f32(&files.path(name), &PointCloud::from_positions(points)?)?;

@@ -260,22 +260,9 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
         lab.clouds.iter().flat_map(|c| c.to_world().positions().to_vec()).collect();
     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
     let build_seconds = t0.elapsed().as_secs_f64();
-    built.rows.push(MapRow {
-        kind: MapKind::Pc.name().to_owned(),
-        backend: map.backend().to_owned(),
-        planar_patches: 0,
-        trimesh_patches: 0,
-        triangles: 0,
-        points: points.len(),
-        memory_bytes: map.memory_bytes(),
-        file_bytes: map.save(std::io::sink())?,
-        build_seconds,
-    });
-    built.drawings.push(MapDrawing {
-        kind: MapKind::Pc.name().to_owned(),
-        points: decimate(&points, MAX_DRAWN).iter().map(p3mm).collect(),
-        ..MapDrawing::default()
-    });
+    let (row, drawing) = point_map_entry(&map, &points, build_seconds)?;
+    built.rows.push(row);
+    built.drawings.push(drawing);
     let name = "map-pc.ply";
     let points_len = points.len();
     write_ply_f32(&files.path(name), &PointCloud::from_positions(points)?)?;
@@ -292,4 +279,30 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
     bar.inc(1);
     bar.finish_and_clear();
     Ok(built)
+}
+
+/// The Table 6.1 row and the drawing of a point-cloud (`pc`) map holding `points`, built in
+/// `build_seconds` — shared by the demo and `patchnav run`.
+pub(crate) fn point_map_entry(
+    map: &AnyMap,
+    points: &[Point3],
+    build_seconds: f64,
+) -> Result<(MapRow, MapDrawing)> {
+    let row = MapRow {
+        kind: MapKind::Pc.name().to_owned(),
+        backend: map.backend().to_owned(),
+        planar_patches: 0,
+        trimesh_patches: 0,
+        triangles: 0,
+        points: points.len(),
+        memory_bytes: map.memory_bytes(),
+        file_bytes: map.save(std::io::sink())?,
+        build_seconds,
+    };
+    let drawing = MapDrawing {
+        kind: MapKind::Pc.name().to_owned(),
+        points: decimate(points, MAX_DRAWN).iter().map(p3mm).collect(),
+        ..MapDrawing::default()
+    };
+    Ok((row, drawing))
 }
