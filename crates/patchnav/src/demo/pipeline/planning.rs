@@ -238,7 +238,7 @@ pub(super) fn plan_all(
                     seed: run_seed,
                     seconds,
                     start: *start,
-                    goals: &goal_points,
+                    goals: goal_points,
                 };
                 runs.push(record.record(run.as_ref(), files)?);
                 bar.inc(1);
