@@ -80,7 +80,7 @@ use patch_extract::quality::{
     MeshStats, spikyness_2d, symmetric_difference_area, symmetric_difference_area_rings,
 };
 use patch_extract::scanline::{ScanLineVersion, scan_line};
-use patch_extract::segment::{RangeNoise, SegmentConfig, segment};
+use patch_extract::segment::{SegmentConfig, segment};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use patch_extract::{PlanarRegion, Segmentation};
 use patch_map::mapfile::{HEADER_LEN, MapCounts, write_map};
@@ -869,11 +869,7 @@ fn real_inputs(dir: &Path, out: &mut String) -> Result<Vec<(bool, SurveyInput)>>
         return Ok(Vec::new());
     }
     // Kinect-class depth noise grows with the square of the range.
-    let kinect = SegmentConfig {
-        noise: RangeNoise { sigma_0: 0.004, sigma_r2: 0.0025 },
-        min_region_size: 300,
-        ..SegmentConfig::range_camera()
-    };
+    let kinect = SegmentConfig::structured_light();
     let files: [(&str, Option<DepthCameraChoice>, &str); 2] = [
         ("pcl_kinect_office/office1.pcd", None, "real: PCL Kinect office1.pcd (640×480)"),
         (
