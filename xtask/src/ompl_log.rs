@@ -130,20 +130,46 @@ pub struct Experiment {
     pub planners: BTreeMap<String, Runs>,
 }
 
+/// The keys of one row of the planning matrix (`bench-matrix roadmap`): the case and one
+/// metric's value.
+pub struct MatrixRow {
+    /// Scene of the case.
+    pub scene: String,
+    /// Backend of the case.
+    pub backend: String,
+    /// Planner of the case.
+    pub planner: String,
+    /// The metric's name.
+    pub metric: String,
+    /// Seed of the case.
+    pub seed: u64,
+    /// The metric's value.
+    pub value: f64,
+}
+
+impl MatrixRow {
+    /// The keys of `r`, or `None` when one is missing or of the wrong type.
+    pub fn of(r: &Value) -> Option<MatrixRow> {
+        let s = |k: &str| r.get(k).and_then(Value::as_str).map(str::to_owned);
+        Some(MatrixRow {
+            scene: s("scene")?,
+            backend: s("backend")?,
+            planner: s("planner")?,
+            metric: s("metric")?,
+            seed: r.get("seed").and_then(Value::as_u64)?,
+            value: r.get("value").and_then(Value::as_f64)?,
+        })
+    }
+}
+
 /// Groups the matrix rows (bench `roadmap`) by scene and backend; a later row of a case and
 /// metric replaces an earlier one.
 pub fn experiments(rows: &[Value]) -> Vec<Experiment> {
     let mut out: BTreeMap<(String, String), Experiment> = BTreeMap::new();
     for r in rows.iter().filter(|r| r.get("bench").and_then(Value::as_str) == Some("roadmap")) {
         let s = |k: &str| r.get(k).and_then(Value::as_str).map(str::to_owned);
-        let (Some(scene), Some(backend), Some(planner), Some(metric), Some(seed), Some(value)) = (
-            s("scene"),
-            s("backend"),
-            s("planner"),
-            s("metric"),
-            r.get("seed").and_then(Value::as_u64),
-            r.get("value").and_then(Value::as_f64),
-        ) else {
+        let Some(MatrixRow { scene, backend, planner, metric, seed, value }) = MatrixRow::of(r)
+        else {
             continue;
         };
         let p = |k: &str| {

@@ -16,6 +16,8 @@
 //! of `roadmap::metrics::quantile`).
 
 mod lab;
+
+use crate::ompl_log::MatrixRow;
 mod office;
 mod volume;
 
@@ -119,14 +121,8 @@ impl Matrix {
             let p = |k: &str| {
                 r.pointer(&format!("/provenance/{k}")).and_then(Value::as_str).map(str::to_owned)
             };
-            let (Some(scene), Some(backend), Some(planner), Some(metric), Some(seed), Some(value)) = (
-                s("scene"),
-                s("backend"),
-                s("planner"),
-                s("metric"),
-                r.get("seed").and_then(Value::as_u64),
-                r.get("value").and_then(Value::as_f64),
-            ) else {
+            let Some(MatrixRow { scene, backend, planner, metric, seed, value }) = MatrixRow::of(r)
+            else {
                 continue;
             };
             m.scene_commands.entry(scene.clone()).or_default().extend(s("command"));
