@@ -16,9 +16,7 @@ use crate::extract::SensorPreset;
 use crate::input::InputArgs;
 use crate::plan::{PlannerChoice, make_planner};
 use crate::progress::Progress;
-use crate::scene_map::{
-    MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map, planar_triangles,
-};
+use crate::scene_map::{MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map};
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
 use patch_core::{CapsuleStep, Patch, Point3, UnspecificStepIntersector};
@@ -167,7 +165,6 @@ impl Maps {
             let load = t0.elapsed().as_secs_f64();
             self.rows.push(crate::demo::pipeline::maps::patch_map_row(
                 kind,
-                backend,
                 &map,
                 (planar, trimesh, triangles),
                 seconds + load,
@@ -198,29 +195,9 @@ impl Maps {
     ) -> Result<()> {
         if let Some(patches) = map.patches() {
             let patches = patches.to_vec();
-            let backend = map.backend().to_owned();
-            let (planar, trimesh) = patches.iter().fold((0, 0), |(a, b), p| match p {
-                Patch::Planar(_) => (a + 1, b),
-                Patch::Trimesh(_) => (a, b + 1),
-            });
-            let mut triangles = 0;
-            for p in &patches {
-                triangles += match p {
-                    Patch::Planar(p) => planar_triangles(p)?.1.len(),
-                    Patch::Trimesh(m) => m.num_triangles(),
-                };
-            }
-            self.rows.push(MapRow {
-                kind: kind.name().to_owned(),
-                backend,
-                planar_patches: planar,
-                trimesh_patches: trimesh,
-                triangles,
-                points: 0,
-                memory_bytes: map.memory_bytes(),
-                file_bytes: map.save(std::io::sink())?,
-                build_seconds: seconds,
-            });
+            let counts = crate::demo::pipeline::maps::patch_counts(&patches)?;
+            self.rows
+                .push(crate::demo::pipeline::maps::patch_map_row(kind, &map, counts, seconds)?);
             self.drawings.push(drawing(kind, &patches));
             if write_3d {
                 let name = format!("map-{kind}.ply");

@@ -70,18 +70,17 @@ pub(crate) struct Built {
     pub(crate) drawings: Vec<MapDrawing>,
 }
 
-/// The Table 6.1 row of a patch map of `kind` held by `backend`, with the counts of
-/// [`patch_counts`]; the file size is that of the map file it would save.
+/// The Table 6.1 row of a patch map of `kind` (its backend's tag from `map`), with the counts
+/// of [`patch_counts`]; the file size is that of the map file it would save.
 pub(crate) fn patch_map_row(
     kind: MapKind,
-    backend: PatchBackend,
     map: &AnyMap,
     (planar, trimesh, triangles): (usize, usize, usize),
     build_seconds: f64,
 ) -> Result<MapRow> {
     Ok(MapRow {
         kind: kind.name().to_owned(),
-        backend: backend.name().to_owned(),
+        backend: map.backend().to_owned(),
         planar_patches: planar,
         trimesh_patches: trimesh,
         triangles,
@@ -225,7 +224,6 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
             let load = t1.elapsed().as_secs_f64();
             built.rows.push(patch_map_row(
                 kind,
-                backend,
                 &map,
                 (planar, trimesh, triangles),
                 extraction + load,
