@@ -60,6 +60,12 @@
 //! | [`RapierMap`] | triangulation + the collider's BVH O(k log k) + one broad-phase insertion O(log P) | P insertions |
 //! | [`PointCloudMap`] | points: amortised O(log² N) each | O(N log N) |
 //!
+//! # Is the map safe?
+//! [`compare`] checks a map against a truth map (a scene's exact surfaces, say) over seeded
+//! random capsule steps or given ones: how many colliding steps the map calls free (unsafe),
+//! how many free ones it blocks (overcautious), each with a 95 % interval, and which truth
+//! surfaces the misses hit.
+//!
 //! # Files and memory
 //! [`MapFile`] saves and loads each backend through the [`mapfile`] container (header with
 //! backend tag and counts, checksums, bincode payload; indices are rebuilt on load);
@@ -67,6 +73,7 @@
 //! map owns.
 
 pub mod bbox6d;
+pub mod compare;
 pub mod from_mesh;
 pub mod kdtree;
 pub mod mapfile;
@@ -85,6 +92,10 @@ pub use point_cloud::{PointCloudMap, PointCloudMapError};
 pub use sampling::{SamplingError, sample_patch_points};
 
 pub use bbox6d::BBox6dMap;
+pub use compare::{
+    Attribution, CompareError, MapComparison, Rate, StepSampling, compare_maps, compare_on_steps,
+    random_steps,
+};
 pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};
 pub use polygon::PolygonMap;
 pub use rapier::RapierMap;

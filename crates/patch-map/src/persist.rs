@@ -21,8 +21,8 @@
 use std::io::{Read, Write};
 
 use patch_core::{
-    CapsuleStep, FromPatches, LineStep, MaybePatchMap, Patch, PatchMap, PatchMapVisitor, Point3,
-    Real, UnspecificStepIntersector,
+    Aabb, CapsuleStep, FromPatches, LineStep, MaybePatchMap, Patch, PatchMap, PatchMapVisitor,
+    Point3, Real, UnspecificStepIntersector,
 };
 
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
@@ -244,6 +244,17 @@ impl AnyMap {
             AnyMap::PointCloud(m) => m.save(writer),
             AnyMap::Trimesh(m) => m.save(writer),
             AnyMap::Rapier(m) => m.save(writer),
+        }
+    }
+
+    /// The box of the held map's patches or points ([`Aabb::EMPTY`] for an empty map).
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            AnyMap::Polygon(m) => m.bounds(),
+            AnyMap::BBox6d(m) => m.bounds(),
+            AnyMap::PointCloud(m) => m.bounds(),
+            AnyMap::Trimesh(m) => m.bounds(),
+            AnyMap::Rapier(m) => m.bounds(),
         }
     }
 

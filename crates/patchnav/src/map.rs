@@ -22,11 +22,12 @@ use crate::scene_map::{
 };
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
-use patch_core::{FromPatches, Patch, PatchMap, Point3};
+use patch_core::{FromPatches, Patch, Point3};
 use patch_map::mapfile::read_header;
 use patch_map::{
-    AnyMap, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap, PolygonMap,
-    RapierMap, TrimeshMap, load_any, planar_patches_from_mesh, sample_patch_points,
+    AnyMap, Attribution, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap,
+    PolygonMap, RapierMap, StepSampling, TrimeshMap, compare_maps, load_any,
+    planar_patches_from_mesh, sample_patch_points,
 };
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
@@ -40,6 +41,9 @@ pub enum MapCommand {
     /// Build a map file from a mesh (its coplanar faces become planar patches), a point cloud
     /// (point-cloud backend only) or another map file.
     Build(BuildArgs),
+    /// Compare a test map with a truth map over random capsule steps: the colliding steps it
+    /// calls free (unsafe) and the free steps it blocks (overcautious), with 95 % intervals.
+    Compare(CompareArgs),
     /// Print a map file's backend, counts, bounds, memory and file size.
     Info {
         /// A map file written by `patchnav map build`.
@@ -114,6 +118,52 @@ pub struct BuildArgs {
     pub input_options: InputArgs,
 }
 
+/// Arguments of `patchnav map compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The truth map (any backend; with patches, unsafe steps are traced to its surfaces).
+    pub truth: PathBuf,
+    /// The map under test (any backend, a point-cloud map included).
+    pub test: PathBuf,
+    /// Robot radius: the capsule's radius, metres.
+    #[arg(long, default_value_t = 0.3)]
+    pub radius: f64,
+    /// Longest step, metres (lengths are uniform in [0, this]).
+    #[arg(long, default_value_t = 1.0)]
+    pub max_length: f64,
+    /// Number of random steps.
+    #[arg(long, default_value_t = 100_000)]
+    pub samples: usize,
+    /// Seed of the steps.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Where steps start and end: xmin,ymin,zmin,xmax,ymax,zmax (default: the truth's bounds).
+    #[arg(long = "box", value_parser = parse_box, allow_hyphen_values = true)]
+    pub bounds: Option<Aabb>,
+    /// How many truth surfaces to list by the unsafe steps that hit them first.
+    #[arg(long, default_value_t = 5)]
+    pub surfaces: usize,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_box(text: &str) -> Result<Aabb, String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("`{text}` is not xmin,ymin,zmin,xmax,ymax,zmax: {e}"))?;
+    match v[..] {
+        [a, b, c, d, e, f] if v.iter().all(|x| x.is_finite()) && a <= d && b <= e && c <= f => {
+            Ok(Aabb::new(Point3::new(a, b, c), Point3::new(d, e, f)))
+        }
+        _ => Err(format!(
+            "`{text}` is not six finite numbers xmin,ymin,zmin,xmax,ymax,zmax with min ≤ max"
+        )),
+    }
+}
+
 /// What a map is built from.
 enum Source {
     Patches(Vec<Patch>),
@@ -124,6 +174,7 @@ enum Source {
 pub fn run(command: &MapCommand, progress: &Progress) -> Result<()> {
     match command {
         MapCommand::Build(args) => build(args, progress),
+        MapCommand::Compare(args) => compare(args, progress),
         MapCommand::Info { file } => {
             print!("{}", describe(file)?);
             Ok(())
@@ -301,14 +352,113 @@ pub fn save_patches(
     })
 }
 
-/// The bounding box of a map's patches or points.
-pub fn map_bounds(map: &AnyMap) -> Aabb {
-    match map {
-        AnyMap::PointCloud(m) => m.bounds(),
-        other => other
-            .patches()
-            .map_or(Aabb::EMPTY, |p| p.iter().fold(Aabb::EMPTY, |b, q| b.union(&q.bounds()))),
+/// `patchnav map compare`: the safety of TEST against TRUTH.
+fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
+    use std::fmt::Write as _;
+    let truth = open_map(&args.truth)?;
+    let test = open_map(&args.test)?;
+    let bounds = args.bounds.unwrap_or_else(|| truth.bounds());
+    if bounds.is_empty() {
+        bail!("{}: the truth map is empty; give --box", args.truth.display());
     }
+    let sampling = StepSampling {
+        radius: args.radius,
+        max_length: args.max_length,
+        samples: args.samples,
+        seed: args.seed,
+        bounds,
+    };
+    let spinner = progress.spinner("comparing");
+    let c = compare_maps(&truth, &test, &sampling, Attribution::FirstContact)?;
+    spinner.finish_and_clear();
+    let surfaces: Vec<SurfaceMisses> = c
+        .unsafe_by_patch()
+        .into_iter()
+        .take(args.surfaces)
+        .map(|(id, steps)| {
+            let patch = truth.patches().and_then(|p| p.get(id.index()));
+            SurfaceMisses {
+                patch: id.0,
+                kind: patch
+                    .map_or("?", |p| if p.as_planar().is_some() { "planar" } else { "trimesh" }),
+                area: patch.map_or(0.0, Patch::area),
+                centre: patch.map_or([0.0; 3], |p| {
+                    let c = p.bounds().center();
+                    [c.x, c.y, c.z]
+                }),
+                steps,
+            }
+        })
+        .collect();
+    if args.json {
+        let report = serde_json::json!({
+            "truth": args.truth.display().to_string(),
+            "test": args.test.display().to_string(),
+            "sampling": sampling,
+            "steps": c.steps(),
+            "truly_colliding": c.truly_colliding(),
+            "truly_free": c.truly_free(),
+            "unsafe": c.unsafe_rate(),
+            "overcautious": c.overcautious_rate(),
+            "unsafe_by_surface": surfaces,
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    let mut out = String::new();
+    let b = sampling.bounds;
+    writeln!(out, "truth:        {} ({} backend)", args.truth.display(), truth.backend())?;
+    writeln!(out, "test:         {} ({} backend)", args.test.display(), test.backend())?;
+    writeln!(
+        out,
+        "steps:        {} capsules of radius {} m, up to {} m long, seed {}, in ({:.2}, {:.2}, {:.2}) .. ({:.2}, {:.2}, {:.2})",
+        c.steps(),
+        sampling.radius,
+        sampling.max_length,
+        sampling.seed,
+        b.min.x,
+        b.min.y,
+        b.min.z,
+        b.max.x,
+        b.max.y,
+        b.max.z
+    )?;
+    writeln!(out, "truth:        {} colliding, {} free", c.truly_colliding(), c.truly_free())?;
+    writeln!(out, "unsafe:       {} (colliding steps the test map calls free)", c.unsafe_rate())?;
+    writeln!(
+        out,
+        "overcautious: {} (free steps the test map calls colliding)",
+        c.overcautious_rate()
+    )?;
+    if !surfaces.is_empty() {
+        writeln!(out, "unsafe steps by the truth surface they touch first:")?;
+        for s in &surfaces {
+            writeln!(
+                out,
+                "  patch {:>5} ({}, {:.2} m², centre {:.2}, {:.2}, {:.2}): {} steps ({:.1} %)",
+                s.patch,
+                s.kind,
+                s.area,
+                s.centre[0],
+                s.centre[1],
+                s.centre[2],
+                s.steps,
+                100.0 * s.steps as f64 / c.unsafe_steps.max(1) as f64
+            )?;
+        }
+    }
+    print!("{out}");
+    Ok(())
+}
+
+/// Unsafe steps that touch one truth surface first.
+#[derive(serde::Serialize)]
+struct SurfaceMisses {
+    patch: u32,
+    kind: &'static str,
+    area: f64,
+    centre: [f64; 3],
+    steps: u64,
 }
 
 /// The text `map info` prints.
@@ -319,14 +469,7 @@ pub fn describe(path: &Path) -> Result<String> {
         read_header(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))?;
     let map = open_map(path)?;
     let file_bytes = std::fs::metadata(path)?.len();
-    let bounds = match &map {
-        AnyMap::PointCloud(m) => m.bounds(),
-        AnyMap::Polygon(m) => m.bounds(),
-        AnyMap::BBox6d(m) => m.bounds(),
-        _ => map
-            .patches()
-            .map_or(Aabb::EMPTY, |p| p.iter().fold(Aabb::EMPTY, |b, q| b.union(&q.bounds()))),
-    };
+    let bounds = map.bounds();
     let c = header.counts;
     let mut out = String::new();
     writeln!(out, "file:            {}", path.display())?;
@@ -392,7 +535,7 @@ mod tests {
         assert!(scanned.len() >= 3, "floor and walls at least: {}", scanned.len());
         assert!(scanned.iter().all(|p| p.as_planar().is_some()), "planes only");
         // Extracted from noisy scans of the 12 × 9 × 4 m room: inside it up to the noise.
-        let b = map_bounds(&map);
+        let b = map.bounds();
         assert!(b.min.x > -0.2 && b.min.y > -0.2 && b.max.x < 12.2 && b.max.y < 9.2, "{b:?}");
         assert!(b.extents().x > 3.0 && b.extents().z > 1.0, "{b:?}");
 
@@ -404,6 +547,36 @@ mod tests {
         assert_ne!(exact.patches().unwrap().len(), scanned.len());
         let area = |p: &[Patch]| p.iter().map(Patch::area).sum::<f64>();
         assert!(area(scanned) < area(exact.patches().unwrap()), "one scan sees less");
+    }
+
+    #[test]
+    fn compare_counts_a_map_against_itself_and_a_scanned_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |n: &str| dir.path().join(n).to_str().unwrap().to_owned();
+        let base = ["map", "build", "--scene", "lab", "--kind", "planes", "--backend", "bbox6d"];
+        let exact = cli(&[&base[..], &["--out", &path("exact.pmap")]].concat()).unwrap();
+        run(&exact, &Progress::new(true)).unwrap();
+        let scanned = [&base[..], &["--source", "scans"], &TOY_SCAN].concat();
+        let scanned = cli(&[&scanned[..], &["--out", &path("scan.pmap")]].concat()).unwrap();
+        run(&scanned, &Progress::new(true)).unwrap();
+        let truth = open_map(Path::new(&path("exact.pmap"))).unwrap();
+        let test = open_map(Path::new(&path("scan.pmap"))).unwrap();
+        let s = StepSampling { samples: 2_000, ..StepSampling::in_box(truth.bounds()) };
+        let same = compare_maps(&truth, &truth, &s, Attribution::None).unwrap();
+        assert_eq!((same.unsafe_steps, same.overcautious_steps), (0, 0));
+        let c = compare_maps(&truth, &test, &s, Attribution::FirstContact).unwrap();
+        assert_eq!(c.steps(), 2_000);
+        assert!(c.unsafe_steps > 0, "one coarse scan cannot see the whole lab");
+        // The command runs with every option, text and JSON.
+        let cmd = ["map", "compare", &path("exact.pmap"), &path("scan.pmap"), "--samples", "500"];
+        run(&cli(&cmd).unwrap(), &Progress::new(true)).unwrap();
+        let boxed = [&cmd[..], &["--box", "-1,0,0,12,9,2", "--json", "--radius", "0.2"]].concat();
+        run(&cli(&boxed).unwrap(), &Progress::new(true)).unwrap();
+        for bad in [&["--box", "1,2,3"][..], &["--box", "0,0,0,-1,1,1"], &["--samples", "x"]] {
+            assert!(cli(&[&cmd[..], bad].concat()).is_err(), "{bad:?}");
+        }
+        let e = run(&cli(&[&cmd[..], &["--radius=-1"]].concat()).unwrap(), &Progress::new(true));
+        assert!(format!("{:#}", e.unwrap_err()).contains("radius"));
     }
 
     #[test]

@@ -134,7 +134,7 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
         bail!("give a MAP with --start, --goal and --radius, or --problem");
     };
     let map = crate::map::open_map(map_path)?;
-    let bounds = crate::map::map_bounds(&map);
+    let bounds = map.bounds();
     if bounds.is_empty() {
         bail!("{}: the map is empty, so it has no bounds to sample in", map_path.display());
     }

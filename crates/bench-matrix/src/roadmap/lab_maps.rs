@@ -59,16 +59,6 @@ pub(crate) struct LabMaps {
     pub start: Point3,
 }
 
-/// The box of a map's patches or points.
-pub(crate) fn map_bounds(map: &AnyMap) -> Aabb {
-    match map {
-        AnyMap::PointCloud(m) => m.bounds(),
-        other => other
-            .patches()
-            .map_or(Aabb::EMPTY, |p| p.iter().fold(Aabb::EMPTY, |b, q| b.union(&q.bounds()))),
-    }
-}
-
 /// The box common to all of `boxes` (their intersection; a box that misses another shrinks
 /// to a flat or point box at the larger min corner, so it stays well formed); the empty box
 /// for none.
@@ -117,7 +107,7 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
             }
             _ => {}
         }
-        let b = map_bounds(&map);
+        let b = map.bounds();
         if b.is_empty() {
             bail!("{}: the {kind} map is empty", path.display());
         }

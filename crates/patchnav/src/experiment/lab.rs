@@ -169,7 +169,7 @@ struct Lab {
 
 /// The box common to all maps.
 pub(crate) fn common_box(maps: &[BuiltMap]) -> Aabb {
-    let boxes: Vec<Aabb> = maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
+    let boxes: Vec<Aabb> = maps.iter().map(|m| m.map.bounds()).collect();
     let min = boxes.iter().fold(boxes[0].min, |a, b| a.sup(&b.min));
     let max = boxes.iter().fold(boxes[0].max, |a, b| a.inf(&b.max));
     Aabb::new(min, max.sup(&min))
@@ -177,8 +177,7 @@ pub(crate) fn common_box(maps: &[BuiltMap]) -> Aabb {
 
 impl Lab {
     fn space(&self, map: &BuiltMap, args: &LabMapArgs) -> Result<PlanningSpace> {
-        let bounds =
-            if args.common_box { common_box(&self.maps) } else { crate::map::map_bounds(&map.map) };
+        let bounds = if args.common_box { common_box(&self.maps) } else { map.map.bounds() };
         PlanningSpace::new(bounds, args.radius, args.step)
             .context("--radius and --step must be positive numbers of metres")
     }
@@ -672,7 +671,7 @@ pub fn run_volume(args: &LabVolumeArgs, progress: &Progress) -> Result<()> {
     let t0 = Instant::now();
     let lab = build_lab(a, progress)?;
     progress.report(table_6_1(&lab, a)?);
-    let bounds: Vec<Aabb> = lab.maps.iter().map(|m| crate::map::map_bounds(&m.map)).collect();
+    let bounds: Vec<Aabb> = lab.maps.iter().map(|m| m.map.bounds()).collect();
     let empty = VoxelGrid::covering(bounds, args.cells)?;
     let runs = lab.maps.len() as u64 * (lab.starts.len() as u64 * args.seeds + args.prm_seeds);
     let bar = progress.bar(runs, "roadmaps");

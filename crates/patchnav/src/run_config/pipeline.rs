@@ -349,7 +349,7 @@ fn check_starts(config: &Config, maps: &Maps) -> Result<()> {
 fn check_start(key: &str, start: &Point3, maps: &Maps, radius: f64) -> Result<()> {
     let at = format!("{key} ({}, {}, {})", start.x, start.y, start.z);
     for m in &maps.built {
-        let b = crate::map::map_bounds(&m.map);
+        let b = m.map.bounds();
         if !b.contains(start) {
             bail!(
                 "{at} is outside the {} map's box ({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
@@ -443,7 +443,7 @@ fn plan(
     let mut runs = Vec::new();
     let mut skipped = Vec::new();
     for m in &maps.built {
-        let space = PlanningSpace::new(crate::map::map_bounds(&m.map), p.radius, p.step)
+        let space = PlanningSpace::new(m.map.bounds(), p.radius, p.step)
             .with_context(|| format!("the {} map's planning space", m.kind))?;
         for &choice in &p.planners {
             if !planner_fits(choice, &m.map) {
@@ -652,11 +652,7 @@ pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<Str
         (None, Some(_)) => clock.lap("explored volume"),
         (None, None) => {}
     }
-    let bounds = maps
-        .built
-        .iter()
-        .map(|m| crate::map::map_bounds(&m.map))
-        .fold(Aabb::EMPTY, |a, b| a.union(&b));
+    let bounds = maps.built.iter().map(|m| m.map.bounds()).fold(Aabb::EMPTY, |a, b| a.union(&b));
     let scene = SceneInfo {
         name: config.name.clone(),
         min: p3(&bounds.min),

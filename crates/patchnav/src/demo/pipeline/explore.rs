@@ -96,7 +96,7 @@ pub(crate) fn explore(
         );
     }
     let cps = e.checkpoints.map(|n| checkpoints(e.iterations, n));
-    let bounds: Vec<Aabb> = targets.iter().map(|t| crate::map::map_bounds(t.map)).collect();
+    let bounds: Vec<Aabb> = targets.iter().map(|t| t.map.bounds()).collect();
     let empty = e.cells.map(|n| VoxelGrid::covering(bounds.iter().copied(), n)).transpose()?;
     let label = if cps.is_some() { "rrt timing" } else { "explored volume" };
     let runs_per_map = (e.starts.len() * e.seeds.len()) as u64;

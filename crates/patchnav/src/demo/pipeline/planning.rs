@@ -190,7 +190,7 @@ impl RunRecord<'_> {
 
 /// The planning space of `map`: its own box (thesis L6460).
 fn space(map: &BuiltMap) -> Result<PlanningSpace> {
-    PlanningSpace::new(crate::map::map_bounds(&map.map), RADIUS, STEP)
+    PlanningSpace::new(map.map.bounds(), RADIUS, STEP)
         .with_context(|| format!("the {} map's planning space", map.kind))
 }
 
