@@ -103,6 +103,10 @@ pub struct BuildArgs {
     /// With --scene: angular step of the simulated ALRF in degrees (default: the S300's 0.5°).
     #[arg(long)]
     pub scan_step_deg: Option<f64>,
+    /// With --scene: multiplier of the simulated ALRF's range noise (1: σ = 3 cm; 0:
+    /// noise-free, without mixed pixels).
+    #[arg(long, default_value_t = 1.0)]
+    pub scan_noise: f64,
     /// The backend of the new map.
     #[arg(long, value_enum)]
     pub backend: BackendChoice,
@@ -255,6 +259,7 @@ fn scene_source(
         height: args.scan_height,
         step_deg: args.scan_step_deg,
         seed: args.scene_seed,
+        noise: args.scan_noise,
     };
     let patches = match (kind, args.source) {
         (MapKind::Pc, _) => None,

@@ -202,6 +202,7 @@ fn build_lab(args: &LabMapArgs, progress: &Progress) -> Result<Lab> {
         height: args.scan_height,
         step_deg: args.scan_step_deg,
         seed: args.scene_seed,
+        noise: 1.0,
     };
     let surfaces = SceneSurfaces::of(&scene, &t)?;
     let mut maps = Vec::new();

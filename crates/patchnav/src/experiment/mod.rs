@@ -5,6 +5,8 @@
 //! * `lab-timing`: RRT time against iterations on the lab's planes, hybrid, trimesh and
 //!   point-cloud maps (§6.1.3, Fig 6.4), as CSV and SVG;
 //! * `lab-volume`: explored volume and its congruence tables (§6.1.1, Tables 6.2 and 6.4);
+//! * `map-safety`: maps built from scans checked against the exact scene (unsafe and
+//!   overcautious steps, sizes, extraction time, roadmap edges re-checked);
 //! * `extraction`: patch extraction quality, the outlining survey and patch sizes (§5.3,
 //!   Figs 5.12–5.14, Table 5.1).
 
@@ -14,6 +16,7 @@ use clap::Subcommand;
 
 mod extraction;
 pub(crate) mod lab;
+mod map_safety;
 mod office;
 mod tof;
 
@@ -32,6 +35,10 @@ pub enum ExperimentCommand {
     /// Thesis §5.3: segmentation quality (SegComp), the outlining survey (Figs 5.12–5.14),
     /// outline fidelity and patch sizes (Table 5.1) on simulated and real scans.
     Extraction(extraction::ExtractionArgs),
+    /// Is a map built from scans safe? Planes, hybrid, trimesh and pc maps of the lab and the
+    /// office at three noise levels and two scan counts, checked against the exact scene:
+    /// unsafe and overcautious step rates, sizes, extraction time, roadmap edges re-checked.
+    MapSafety(map_safety::MapSafetyArgs),
     /// Thesis Table 2.4: the adaptive amplitude threshold against amplitude thresholds, with
     /// unwrapping, two-frequency unwrapping and the spatial check, on six simulated scenes
     /// (and a real frame folded at a chosen non-ambiguity range with `--real`).
@@ -46,5 +53,6 @@ pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
         ExperimentCommand::LabVolume(args) => lab::run_volume(args, progress),
         ExperimentCommand::Extraction(args) => extraction::run(args, progress),
         ExperimentCommand::Tof(args) => tof::run(args, progress),
+        ExperimentCommand::MapSafety(args) => map_safety::run(args, progress),
     }
 }

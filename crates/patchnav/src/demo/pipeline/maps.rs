@@ -45,7 +45,8 @@ pub(crate) struct Lab {
 /// Simulates the lab's ALRF scans and writes each (`scan-N.ply`, sensor frame with its pose).
 pub(super) fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Result<Lab> {
     let scene = scene_sim::lab(seed).context("building the lab scene")?;
-    let setup = ScanSetup { scans: settings.scans, height: SCAN_HEIGHT, step_deg: None, seed };
+    let setup =
+        ScanSetup { scans: settings.scans, height: SCAN_HEIGHT, step_deg: None, seed, noise: 1.0 };
     let clouds = scan_clouds(&scene, &setup)?;
     let mut positions = Vec::with_capacity(clouds.len());
     let mut points = 0;

@@ -1,0 +1,331 @@
+//! `patchnav experiment map-safety`: is a map built from scans safe to plan on?
+//!
+//! For each scene (lab, office), sensor noise level and number of scans, the planes, hybrid,
+//! trimesh and pc maps are built from simulated ALRF scans as `patchnav map build --source
+//! scans` builds them, and each is compared with the scene's exact surfaces (the hybrid map
+//! of `--source scene`) over seeded random capsule steps ([`patch_map::compare`]):
+//!
+//! * **unsafe**: colliding steps the map calls free, over all truly colliding steps;
+//! * **overcautious**: free steps the map calls colliding, over all truly free steps.
+//!
+//! The pc map's unsafe rate is the occlusion floor: surfaces no scan saw (or saw with too
+//! few points). A planner view grows RRT and PRM roadmaps on each map and re-checks every
+//! edge on the truth: the share of edges that collide, and of paths to the goals that
+//! contain a colliding edge. The tuning seed of the extraction is 0; the default step and
+//! planner seeds are 1, and the scene seed is a flag.
+
+use crate::progress::Progress;
+use crate::scene_map::{
+    MapKind, PatchBackend, ScanSetup, SceneSurfaces, Tessellation, extracted_patches, patch_map,
+    scan_clouds,
+};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_map::{AnyMap, Attribution, MapComparison, PointCloudMap, StepSampling, compare_maps};
+use roadmap::{Goal, MaxIterations, PlannerKind, PlanningSpace, Problem, named_planner_on};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+/// Arguments of `patchnav experiment map-safety`.
+#[derive(Args, Debug, Clone)]
+pub struct MapSafetyArgs {
+    /// Scenes, comma-separated (`lab`, `office`).
+    #[arg(long, value_delimiter = ',', default_values_t = ["lab".to_owned(), "office".to_owned()])]
+    pub scenes: Vec<String>,
+    /// Noise levels as multipliers of the S300 model's σ = 3 cm, comma-separated (0 is
+    /// noise-free and without mixed pixels).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 1.0, 2.0])]
+    pub noise: Vec<Real>,
+    /// Numbers of scans, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [8usize, 29])]
+    pub scans: Vec<usize>,
+    /// The map types, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = MapKind::ALL)]
+    pub maps: Vec<MapKind>,
+    /// Random capsule steps per map.
+    #[arg(long, default_value_t = 100_000)]
+    pub samples: usize,
+    /// Seed of the random steps and the planners.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Seed of the scene's furniture, the scan poses and the sensor noise.
+    #[arg(long, default_value_t = 0)]
+    pub scene_seed: u64,
+    /// Robot radius, metres.
+    #[arg(long, default_value_t = 0.3)]
+    pub radius: Real,
+    /// Longest random step, metres.
+    #[arg(long, default_value_t = 1.0)]
+    pub max_length: Real,
+    /// Iterations of each RRT and PRM run in the planner view (0: no planner view).
+    #[arg(long, default_value_t = 2000)]
+    pub planner_iterations: u64,
+    /// Planner runs per planner and map (seeds `seed`, `seed + 1`, ...).
+    #[arg(long, default_value_t = 2)]
+    pub planner_seeds: u64,
+    /// Height of the scanner above the floor, metres.
+    #[arg(long, default_value_t = 0.5)]
+    pub scan_height: Real,
+    /// Angular step of the simulated ALRF in degrees (default: the S300's 0.5°).
+    #[arg(long)]
+    pub scan_step_deg: Option<Real>,
+    /// Also write the rows as JSON to this file.
+    #[arg(long)]
+    pub json: Option<std::path::PathBuf>,
+}
+
+/// One row of the table: one map of one scene, noise level and scan count.
+#[derive(Clone, Debug, Serialize)]
+pub struct SafetyRow {
+    /// The scene.
+    pub scene: String,
+    /// Noise multiplier.
+    pub noise: Real,
+    /// Number of scans.
+    pub scans: usize,
+    /// The map type.
+    pub map: String,
+    /// The comparison with the truth.
+    pub comparison: MapComparison,
+    /// Map file bytes.
+    pub file_bytes: u64,
+    /// Heap bytes of the map in its backend.
+    pub memory_bytes: usize,
+    /// Extraction (or, for the pc map, point gathering) time per scan, seconds.
+    pub seconds_per_scan: Real,
+    /// Planner view: roadmap edges re-checked on the truth.
+    pub edges: u64,
+    /// Of those, edges that collide with the truth.
+    pub colliding_edges: u64,
+    /// Paths to goals found.
+    pub paths: u64,
+    /// Of those, paths with at least one colliding edge.
+    pub colliding_paths: u64,
+}
+
+/// Counts the bytes written.
+struct ByteCount(u64);
+
+impl std::io::Write for ByteCount {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0 += buf.len() as u64;
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Runs `patchnav experiment map-safety`.
+pub fn run(args: &MapSafetyArgs, progress: &Progress) -> Result<()> {
+    let rows = safety_rows(args, progress)?;
+    print!("{}", safety_table(&rows));
+    if let Some(path) = &args.json {
+        std::fs::write(path, serde_json::to_string_pretty(&rows)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Every row of the experiment.
+pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<SafetyRow>> {
+    if args.scenes.is_empty() || args.noise.is_empty() || args.scans.is_empty() {
+        bail!("--scenes, --noise and --scans each need at least one value");
+    }
+    let mut rows = Vec::new();
+    for name in &args.scenes {
+        if !["lab", "office"].contains(&name.as_str()) {
+            bail!("unknown scene `{name}`; map-safety runs on `lab` and `office`");
+        }
+        let scene = scene_sim::scene_by_name(name, args.scene_seed)
+            .with_context(|| format!("building scene `{name}`"))?;
+        let t = Tessellation::lab();
+        let truth_patches = SceneSurfaces::of(&scene, &t)?
+            .patches(MapKind::Hybrid, &t)?
+            .context("the truth has patches")?;
+        let truth = patch_map(truth_patches, PatchBackend::Bbox6d)?;
+        let sampling = StepSampling {
+            radius: args.radius,
+            max_length: args.max_length,
+            samples: args.samples,
+            seed: args.seed,
+            bounds: truth.bounds(),
+        };
+        for &noise in &args.noise {
+            for &scans in &args.scans {
+                let setup = ScanSetup {
+                    scans,
+                    height: args.scan_height,
+                    step_deg: args.scan_step_deg,
+                    seed: args.scene_seed,
+                    noise,
+                };
+                let spinner = progress.spinner(&format!("{name} noise {noise} scans {scans}"));
+                let clouds = scan_clouds(&scene, &setup)?;
+                for &kind in &args.maps {
+                    let started = Instant::now();
+                    let map = match extracted_patches(&clouds, kind)? {
+                        Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
+                        None => {
+                            let points: Vec<Point3> = clouds
+                                .iter()
+                                .flat_map(|c| c.to_world().positions().to_vec())
+                                .collect();
+                            AnyMap::PointCloud(PointCloudMap::from_points(&points)?)
+                        }
+                    };
+                    let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
+                    let mut bytes = ByteCount(0);
+                    map.save(&mut bytes)?;
+                    let comparison = compare_maps(&truth, &map, &sampling, Attribution::None)?;
+                    let mut row = SafetyRow {
+                        scene: name.clone(),
+                        noise,
+                        scans,
+                        map: kind.name().to_owned(),
+                        comparison,
+                        file_bytes: bytes.0,
+                        memory_bytes: map.memory_bytes(),
+                        seconds_per_scan,
+                        edges: 0,
+                        colliding_edges: 0,
+                        paths: 0,
+                        colliding_paths: 0,
+                    };
+                    if args.planner_iterations > 0 {
+                        planner_view(&truth, &map, args, &mut row)?;
+                    }
+                    progress.say(format!(
+                        "{name} noise {noise} scans {scans} {kind}: unsafe {}, overcautious {}",
+                        row.comparison.unsafe_rate(),
+                        row.comparison.overcautious_rate()
+                    ));
+                    rows.push(row);
+                }
+                spinner.finish_and_clear();
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// Up to `n` points free on both maps, spread over the box (a deterministic spiral of
+/// candidates on a coarse lattice at 1 m height).
+fn free_points(truth: &AnyMap, map: &AnyMap, radius: Real, n: usize) -> Vec<Point3> {
+    let b = truth.bounds();
+    let free = |p: &Point3| {
+        CapsuleStep::sphere(*p, radius)
+            .is_ok_and(|s| truth.is_step_free(&s) && map.is_step_free(&s))
+    };
+    let mut out = Vec::new();
+    // Corners first (the lab experiments' starts), then a lattice walk toward the centre.
+    let inset = |lo: Real, hi: Real, f: Real| lo + (hi - lo) * f;
+    for f in [0.1, 0.2, 0.3, 0.4] {
+        for (fx, fy) in [(f, f), (1.0 - f, f), (1.0 - f, 1.0 - f), (f, 1.0 - f)] {
+            let p = Point3::new(
+                inset(b.min.x, b.max.x, fx),
+                inset(b.min.y, b.max.y, fy),
+                b.min.z + 1.0,
+            );
+            if out.len() < n && free(&p) && out.iter().all(|q: &Point3| (q - p).norm() > 1.0) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// Grows RRT and PRM on `map` from one free point toward three others, re-checks every edge
+/// on the truth, and counts colliding edges and paths.
+fn planner_view(
+    truth: &AnyMap,
+    map: &AnyMap,
+    args: &MapSafetyArgs,
+    row: &mut SafetyRow,
+) -> Result<()> {
+    let points = free_points(truth, map, args.radius, 4);
+    let Some((start, goals)) = points.split_first() else {
+        return Ok(());
+    };
+    let problem = Problem {
+        start: *start,
+        goals: goals.iter().map(|&center| Goal { center, tolerance: 0.5 }).collect(),
+    };
+    let space = PlanningSpace::new(truth.bounds(), args.radius, 1.0)
+        .context("the planning space of the truth's box")?;
+    for kind in [PlannerKind::Rrt, PlannerKind::Prm] {
+        for k in 0..args.planner_seeds {
+            let mut planner = named_planner_on(kind, map, space, args.seed + k)?;
+            planner.solve(&problem, &mut MaxIterations(args.planner_iterations));
+            let graph = planner.roadmap();
+            let collides = |a: &Point3, b: &Point3| {
+                CapsuleStep::new(*a, *b, args.radius).is_ok_and(|s| !truth.is_step_free(&s))
+            };
+            for e in graph.edge_indices() {
+                if let Some((a, b)) = graph.edge_endpoints(e) {
+                    row.edges += 1;
+                    row.colliding_edges += u64::from(collides(&graph[a], &graph[b]));
+                }
+            }
+            for g in 0..problem.goals.len() {
+                if let Some(path) = planner.path_to(g) {
+                    row.paths += 1;
+                    row.colliding_paths +=
+                        u64::from(path.windows(2).any(|w| collides(&w[0], &w[1])));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn pct(count: u64, total: u64) -> String {
+    if total == 0 {
+        "–".to_owned()
+    } else {
+        format!("{:.2}", 100.0 * count as Real / total as Real)
+    }
+}
+
+/// The table as markdown: one block per scene, noise and scan count.
+pub fn safety_table(rows: &[SafetyRow]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "| scene | noise | scans | map | unsafe % [95 %] | over- cautious % [95 %] | unsafe − floor | file bytes | memory bytes | s / scan | colliding edges % | colliding paths % |"
+    );
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let floor = rows
+            .iter()
+            .find(|q| {
+                q.scene == r.scene && q.noise == r.noise && q.scans == r.scans && q.map == "pc"
+            })
+            .map(|q| q.comparison.unsafe_rate().value);
+        let u = r.comparison.unsafe_rate();
+        let o = r.comparison.overcautious_rate();
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.2} [{:.2}, {:.2}] | {:.2} [{:.2}, {:.2}] | {} | {} | {} | {:.3} | {} | {} |",
+            r.scene,
+            r.noise,
+            r.scans,
+            r.map,
+            100.0 * u.value,
+            100.0 * u.low,
+            100.0 * u.high,
+            100.0 * o.value,
+            100.0 * o.low,
+            100.0 * o.high,
+            floor.map_or("–".to_owned(), |f| format!("{:+.2}", 100.0 * (u.value - f))),
+            r.file_bytes,
+            r.memory_bytes,
+            r.seconds_per_scan,
+            pct(r.colliding_edges, r.edges),
+            pct(r.colliding_paths, r.paths),
+        );
+    }
+    out
+}
