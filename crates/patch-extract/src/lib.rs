@@ -19,6 +19,7 @@
 //! | spikyness, mesh statistics, outline fidelity | [`quality`] | L5148–5154 |
 //! | trimesh growing (Alg 4 and 5) | [`trimesh_grow`] | L4484–4620 |
 //! | outline merging across scans | [`merge`] | §5.1 |
+//! | conservative outline offset | [`offset`] | — (ours) |
 //! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
 //!
 //! Every parameter the thesis leaves open (segmentation thresholds, α rule details, DP ε,
@@ -35,6 +36,7 @@ pub mod evaluate;
 pub mod grid_mesh;
 pub mod hull;
 pub mod merge;
+pub mod offset;
 pub mod pipeline;
 pub mod plane_fit;
 pub mod polygonize;
@@ -50,5 +52,5 @@ pub use merge::{MergeConfig, merge_coplanar};
 pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
-pub use segment::{SegmentConfig, segment};
+pub use segment::{GrazingPlanes, SegmentConfig, segment};
 pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};

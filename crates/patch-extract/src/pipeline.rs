@@ -40,11 +40,12 @@ pub struct PipelineConfig {
 
 impl PipelineConfig {
     /// For actuated-LRF scans (S300-like, 1–3 cm noise): [`SegmentConfig::alrf`],
-    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    /// [`PolygonizeConfig::conservative`] (outlines grown to cover what the scan saw),
+    /// merging with [`MergeConfig::alrf`], no remainder meshes.
     pub fn alrf() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::alrf(),
-            polygonize: PolygonizeConfig::thesis(),
+            polygonize: PolygonizeConfig::conservative(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
         }

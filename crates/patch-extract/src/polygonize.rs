@@ -18,6 +18,7 @@ use pointcloud::PointCloud;
 use crate::PlanarRegion;
 use crate::alpha_shape::{AlphaShapeConfig, AlphaShapeError, alpha_shape};
 use crate::hull::{HullError, convex_hull_polygon};
+use crate::offset::{OutlineOffset, grow_polygon};
 use crate::projection::{ProjectionConfig, ProjectionError, ProjectionTiming, project_region};
 use crate::simplify::{SimplifyError, simplify_polygon, simplify_polygon_valid};
 
@@ -59,6 +60,9 @@ pub struct PolygonizeConfig {
     pub outline: OutlineMethod,
     /// The simplification.
     pub simplification: Simplification,
+    /// A conservative outward offset of the simplified outline ([`crate::offset`]); `None`:
+    /// the outline as found (the thesis).
+    pub offset: Option<OutlineOffset>,
 }
 
 /// The Douglas–Peucker ε of [`PolygonizeConfig::thesis`], metres. The thesis gives none; 2 cm
@@ -76,7 +80,14 @@ impl PolygonizeConfig {
             projection: ProjectionConfig::thesis(),
             outline: OutlineMethod::AlphaShape(AlphaShapeConfig::thesis()),
             simplification: Simplification::DouglasPeuckerValid { epsilon: THESIS_DP_EPSILON },
+            offset: None,
         }
+    }
+
+    /// [`PolygonizeConfig::thesis`] with outlines grown by [`OutlineOffset::alrf`], so patches
+    /// cover the surface between and beyond their outermost points (not in the thesis).
+    pub fn conservative() -> PolygonizeConfig {
+        PolygonizeConfig { offset: Some(OutlineOffset::alrf()), ..PolygonizeConfig::thesis() }
     }
 
     /// The thesis's pipeline with a different Douglas–Peucker ε (e.g. 3 cm for noisier
@@ -94,6 +105,7 @@ impl PolygonizeConfig {
             projection: ProjectionConfig::thesis(),
             outline: OutlineMethod::ConvexHull,
             simplification: Simplification::None,
+            offset: None,
         }
     }
 }
@@ -119,6 +131,9 @@ pub enum PolygonizeError {
     /// The patch could not be built.
     #[error(transparent)]
     Patch(#[from] PatchError),
+    /// An outline offset parameter is negative or not finite.
+    #[error("outline offset parameters must be finite and ≥ 0")]
+    BadOffset,
 }
 
 /// [`polygonize_region`]'s result: the patches and what happened on the way.
@@ -173,6 +188,17 @@ pub fn polygonize_region(
             }
         })
         .collect::<Result<_, _>>()?;
+    let simplified: Vec<Polygon> = match config.offset {
+        Some(offset) if offset.is_valid() => simplified
+            .into_iter()
+            .map(|p| {
+                let d = offset.distance(p.area(), projected.points.len(), region.mse);
+                grow_polygon(&p, d).unwrap_or(p)
+            })
+            .collect(),
+        Some(_) => return Err(PolygonizeError::BadOffset),
+        None => simplified,
+    };
     let vertices_after = simplified.iter().map(Polygon::num_vertices).sum();
     let mut patches = Vec::with_capacity(simplified.len());
     for polygon in simplified {

@@ -45,8 +45,10 @@
 //!    while the region is small and thereafter whenever it has grown by 5 %; the running
 //!    sums are exact, so the final plane is the exact least-squares fit of the region's
 //!    points. A point rejected from one region point may be accepted later from another.
-//! 5. **Minimum size.** A region that stops growing with fewer than `min_region_size` points
-//!    is dissolved: its points become free again (later seeds may use them).
+//! 5. **Minimum size.** A region that stops growing with fewer than `min_region_size` points,
+//!    or whose plane then fails the incidence test (with [`GrazingPlanes`], the stricter
+//!    region form of it), is dissolved: its points become free again (later seeds may use
+//!    them).
 //! 6. **Bending test** (optional, [`SegmentConfig::max_bending`] `= Some(b)`). A region that
 //!    reaches the minimum size is fitted once more: with `(u, v)` its points' coordinates
 //!    along the plane's in-plane axes (centred, scaled by their RMS) and `dᵢ` their signed
@@ -125,6 +127,45 @@ impl RangeNoise {
     }
 }
 
+/// Surfaces seen at grazing incidence that are planes all the same: the undersides of table
+/// tops and rack boards a scanner below them sees, the floor far away.
+///
+/// A strip of pixels gives a "plane" through the sensor (see
+/// [`SegmentConfig::min_incidence_cos`]): its distance from the sensor is zero up to noise.
+/// A real surface seen grazingly keeps its distance: a table underside 0.22 m above the
+/// scanner is 0.22 m from it however far away it is seen. So a seed or region whose plane
+/// fails the incidence test is accepted iff `|n · c| ≥ min_cos · |c|` **and** the centroid
+/// lies at least `min_offset_sigmas · σ(|c|)` above or below the sensor (`c` the centroid
+/// relative to the sensor; the height, not the plane's distance from the sensor, because a
+/// tilted strip through the sensor's height misses the sensor by its tilt times the range) **and** the plane is within `max_tilt` of horizontal (its normal within
+/// `max_tilt` of the world's up, taken from the cloud's sensor pose; without a pose the
+/// sensor frame's z is up).
+///
+/// Why horizontal only: the grazing surfaces a ground robot's scanner cannot see better
+/// from elsewhere are the undersides of things above it and the floor far away, all
+/// horizontal; accepting grazing planes of any orientation lets the curved (conical) pixel
+/// columns of an actuated scanner, whose planes miss the sensor by more than the noise, in
+/// as large phantom planes (measured on the lab: 7.6 % of free steps blocked).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct GrazingPlanes {
+    /// The most grazing incidence accepted, as its cosine, in [0, 1).
+    pub min_cos: Real,
+    /// The plane's least distance from the sensor in units of the noise σ at the centroid's
+    /// range (finite, ≥ 0).
+    pub min_offset_sigmas: Real,
+    /// The largest angle between a region's plane normal and the world's up (or down),
+    /// radians, in [0, π/2].
+    pub max_tilt: Real,
+    /// The same for a seed window's plane, whose few points give a rougher normal, radians,
+    /// in [0, π/2].
+    pub max_seed_tilt: Real,
+    /// A region's least RMS extent along its narrower in-plane axis, in units of the noise σ
+    /// at the centroid's range (finite, ≥ 0; seeds are not tested). A strip one or two pixel
+    /// rows wide is a line in space whose "plane" any rotation about the line fits: its
+    /// normal, and so its incidence, says nothing.
+    pub min_width_sigmas: Real,
+}
+
 /// Parameters of [`segment`]. No `Default`: start from a named preset and adjust.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct SegmentConfig {
@@ -148,6 +189,9 @@ pub struct SegmentConfig {
     /// their beams, inside that plane), so without this test thin strips across several
     /// surfaces make perfect "planes".
     pub min_incidence_cos: Real,
+    /// Planes seen more grazingly than `min_incidence_cos` that are accepted all the same
+    /// ([`GrazingPlanes`]); `None`: none (the strict test above).
+    pub grazing: Option<GrazingPlanes>,
     /// Seed window half-size in pixels for organised clouds (1 = 3×3, 2 = 5×5; ≥ 1).
     pub seed_radius: u32,
     /// Organised clouds: the seed window is widened (every `t`-th pixel, `t ≤ 32` per grid
@@ -211,6 +255,13 @@ impl SegmentConfig {
             jump_relative: 0.1,
             min_region_size: 100,
             min_incidence_cos: 0.2,
+            grazing: Some(GrazingPlanes {
+                min_cos: 0.03,
+                min_offset_sigmas: 3.0,
+                max_tilt: 8f64.to_radians(),
+                max_seed_tilt: 15f64.to_radians(),
+                min_width_sigmas: 3.0,
+            }),
             seed_radius: 2,
             seed_min_extent: ALRF_SEED_MIN_EXTENT,
             knn: 8,
@@ -234,6 +285,7 @@ impl SegmentConfig {
             jump_relative: 0.05,
             min_region_size: 100,
             min_incidence_cos: 0.2,
+            grazing: None,
             seed_radius: 1,
             seed_min_extent: 0.0,
             knn: 8,
@@ -261,6 +313,7 @@ impl SegmentConfig {
             jump_relative: 0.05,
             min_region_size: 500,
             min_incidence_cos: 0.2,
+            grazing: None,
             seed_radius: 2,
             seed_min_extent: 0.0,
             knn: 8,
@@ -282,6 +335,7 @@ impl SegmentConfig {
             jump_relative: 0.1,
             min_region_size: 50,
             min_incidence_cos: 0.1,
+            grazing: None,
             seed_radius: 1,
             seed_min_extent: 0.0,
             knn: 8,
@@ -327,6 +381,28 @@ impl SegmentConfig {
                 allowed: "in [0, 1)",
             });
         }
+        if let Some(g) = self.grazing {
+            if !(g.min_cos >= 0.0 && g.min_cos < 1.0) {
+                return Err(SegmentError::BadParameter {
+                    name: "grazing.min_cos",
+                    value: g.min_cos,
+                    allowed: "in [0, 1)",
+                });
+            }
+            non_negative("grazing.min_offset_sigmas", g.min_offset_sigmas)?;
+            non_negative("grazing.min_width_sigmas", g.min_width_sigmas)?;
+            for (name, value) in
+                [("grazing.max_tilt", g.max_tilt), ("grazing.max_seed_tilt", g.max_seed_tilt)]
+            {
+                if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&value) {
+                    return Err(SegmentError::BadParameter {
+                        name,
+                        value,
+                        allowed: "in [0, π/2] radians",
+                    });
+                }
+            }
+        }
         at_least("min_region_size", self.min_region_size, 4)?;
         at_least("seed_radius", self.seed_radius as usize, 1)?;
         at_least("knn", self.knn, 3)?;
@@ -348,10 +424,18 @@ pub fn segment(cloud: &PointCloud, config: &SegmentConfig) -> Result<Segmentatio
     match cloud.grid() {
         Some(grid) if !cloud.is_empty() => {
             let graph = Graph::grid(grid, cloud.positions(), config);
-            Ok(grow(cloud.positions(), &graph, config))
+            Ok(grow(cloud.positions(), &graph, config, up(cloud)))
         }
         _ => segment_unorganised(cloud, config),
     }
+}
+
+/// The world's up (+z) in the sensor frame of `cloud` (+z without a pose).
+fn up(cloud: &PointCloud) -> Vector3 {
+    cloud.sensor_pose().map_or_else(Vector3::z, |pose| {
+        let up = pose.world_from_sensor.rotation.inverse() * Vector3::z();
+        if up.iter().all(|c| c.is_finite()) { up } else { Vector3::z() }
+    })
 }
 
 /// [`segment`] with k-nearest-neighbour neighbourhoods even if `cloud` is organised.
@@ -367,7 +451,7 @@ pub fn segment_unorganised(
         return Ok(Segmentation::default());
     }
     let graph = Graph::knn(cloud.positions(), config.knn, config.knn_radius);
-    Ok(grow(cloud.positions(), &graph, config))
+    Ok(grow(cloud.positions(), &graph, config, up(cloud)))
 }
 
 /// Neighbourhoods of the points: pixel grid or k-NN lists.
@@ -563,6 +647,8 @@ struct Tests<'a> {
     range: Vec<Real>,
     sigma: Vec<Real>,
     config: &'a SegmentConfig,
+    /// The world's up in the sensor frame.
+    up: Vector3,
 }
 
 impl Tests<'_> {
@@ -576,9 +662,23 @@ impl Tests<'_> {
         plane.signed_distance(&self.points[m]).abs() <= self.config.distance_factor * self.sigma[m]
     }
 
-    fn facing(&self, fit: &PlaneFit) -> bool {
+    /// The incidence test of a region's plane (`seed`: of a seed window's).
+    fn facing(&self, fit: &PlaneFit, seed: bool) -> bool {
         let c = fit.centroid.coords;
-        fit.plane.normal.dot(&c).abs() >= self.config.min_incidence_cos * c.norm()
+        let (offset, range) = (fit.plane.normal.dot(&c).abs(), c.norm());
+        if offset >= self.config.min_incidence_cos * range {
+            return true;
+        }
+        let sigma = self.config.noise.sigma(range);
+        self.config.grazing.is_some_and(|g| {
+            offset >= g.min_cos * range
+                && c.dot(&self.up).abs() >= g.min_offset_sigmas * sigma
+                && (seed
+                    || fit.eigenvalues[1]
+                        >= (g.min_width_sigmas * sigma).powi(2) * fit.count as Real)
+                && fit.plane.normal.dot(&self.up).abs()
+                    >= if seed { g.max_seed_tilt } else { g.max_tilt }.cos()
+        })
     }
 
     fn mse_ok(&self, mse: Real, sum_sigma2: Real, count: usize) -> bool {
@@ -638,11 +738,11 @@ struct Grown {
     acc: PlaneAccumulator,
 }
 
-fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig) -> Segmentation {
+fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector3) -> Segmentation {
     let n = points.len();
     let range: Vec<Real> = points.iter().map(|p| p.coords.norm()).collect();
     let sigma: Vec<Real> = range.iter().map(|&r| config.noise.sigma(r)).collect();
-    let tests = Tests { points, range, sigma, config };
+    let tests = Tests { points, range, sigma, config, up };
     let origin = Point3::origin();
 
     // Seed order: flattest windows first.
@@ -680,7 +780,7 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig) -> Segment
         let mut sum_sigma2: Real =
             window.iter().map(|&(p, _)| tests.sigma[p as usize].powi(2)).sum();
         if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
-            || !tests.facing(&fit)
+            || !tests.facing(&fit, true)
             || !window.iter().all(|&(p, _)| tests.near_plane(&fit.plane, p as usize))
         {
             continue;
@@ -722,7 +822,9 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig) -> Segment
                 }
             }
         }
-        if queue.len() < config.min_region_size {
+        if queue.len() < config.min_region_size
+            || !acc.fit(&origin).is_some_and(|f| tests.facing(&f, false))
+        {
             for &p in &queue {
                 owner[p as usize] = FREE;
             }
@@ -743,7 +845,7 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig) -> Segment
         let mut pts = g.points;
         pts.sort_unstable();
         match g.acc.fit(&origin) {
-            Some(fit) if tests.facing(&fit) => regions.push(region_from_fit(pts, &fit)),
+            Some(fit) if tests.facing(&fit, false) => regions.push(region_from_fit(pts, &fit)),
             _ => {
                 for &p in &pts {
                     owner[p as usize] = FREE;

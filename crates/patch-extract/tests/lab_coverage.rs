@@ -453,5 +453,7 @@ fn alrf_preset_segments_a_box_face_close_to_the_sensor() {
         segmented_share(&scene, cloud, &segment(cloud, &contiguous).unwrap(), "box-3/-x");
     assert!(n > 10_000, "the face fills a large part of the scan: {n} points");
     assert!(widened >= 0.85, "widened seed windows: {widened:.3} of {n} points in regions");
-    assert!(narrow < 0.2, "contiguous windows were expected to miss the face: {narrow:.3}");
+    // Contiguous windows seed only part of it (dissolved grazing regions free their points
+    // for later seeds, so some is found).
+    assert!(narrow < 0.5, "contiguous windows were expected to miss most of the face: {narrow:.3}");
 }

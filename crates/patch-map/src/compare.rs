@@ -203,17 +203,19 @@ impl std::fmt::Display for Rate {
 pub enum Attribution {
     /// Count only.
     None,
-    /// Also ask the truth map for each unsafe step's first contact (needs a truth map with
-    /// patches; a point-cloud truth gives no contacts).
+    /// Also ask for the first contact of each step the maps disagree on: an unsafe step's
+    /// on the truth, an overcautious step's on the test map (a map without patches, a
+    /// point-cloud map, gives no contacts).
     FirstContact,
 }
 
-/// An unsafe step and where it first touches the truth.
+/// A step the two maps disagree on and where it first touches the map that calls it
+/// colliding (the truth for an unsafe step, the test map for an overcautious one).
 #[derive(Copy, Clone, Debug, PartialEq, Serialize)]
 pub struct UnsafeStep {
     /// The step (index into the compared steps).
     pub index: usize,
-    /// The truth patch touched first.
+    /// The patch touched first.
     pub patch: PatchId,
     /// The contact point on it.
     pub point: Point3,
@@ -231,8 +233,12 @@ pub struct MapComparison {
     /// Steps free in the truth that the test map calls colliding.
     pub overcautious_steps: u64,
     /// With [`Attribution::FirstContact`] and a truth with patches: every unsafe step's first
-    /// contact, in step order.
+    /// contact with the truth, in step order.
     pub unsafe_contacts: Vec<UnsafeStep>,
+    /// With [`Attribution::FirstContact`] and a test map with patches: every overcautious
+    /// step's first contact with the test map (the patch that blocks free space), in step
+    /// order.
+    pub overcautious_contacts: Vec<UnsafeStep>,
 }
 
 impl MapComparison {
@@ -263,13 +269,12 @@ impl MapComparison {
 
     /// Unsafe steps per truth patch touched first, most first (ties by patch id).
     pub fn unsafe_by_patch(&self) -> Vec<(PatchId, u64)> {
-        let mut counts: BTreeMap<PatchId, u64> = BTreeMap::new();
-        for c in &self.unsafe_contacts {
-            *counts.entry(c.patch).or_default() += 1;
-        }
-        let mut v: Vec<_> = counts.into_iter().collect();
-        v.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-        v
+        by_patch(&self.unsafe_contacts)
+    }
+
+    /// Overcautious steps per test-map patch touched first, most first (ties by patch id).
+    pub fn overcautious_by_patch(&self) -> Vec<(PatchId, u64)> {
+        by_patch(&self.overcautious_contacts)
     }
 
     fn add(&mut self, other: MapComparison) {
@@ -278,7 +283,19 @@ impl MapComparison {
         self.unsafe_steps += other.unsafe_steps;
         self.overcautious_steps += other.overcautious_steps;
         self.unsafe_contacts.extend(other.unsafe_contacts);
+        self.overcautious_contacts.extend(other.overcautious_contacts);
     }
+}
+
+/// Steps per patch, most first (ties by patch id).
+fn by_patch(contacts: &[UnsafeStep]) -> Vec<(PatchId, u64)> {
+    let mut counts: BTreeMap<PatchId, u64> = BTreeMap::new();
+    for c in contacts {
+        *counts.entry(c.patch).or_default() += 1;
+    }
+    let mut v: Vec<_> = counts.into_iter().collect();
+    v.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    v
 }
 
 /// Asks a patch map for a step's first contact (through [`MaybePatchMap`]).
@@ -304,7 +321,7 @@ pub fn compare_on_steps<T, M>(
 ) -> MapComparison
 where
     T: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
-    M: UnspecificStepIntersector<CapsuleStep> + Sync,
+    M: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
 {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 64);
     let chunk = steps.len().div_ceil(threads).max(1);
@@ -314,7 +331,18 @@ where
             match (truth.is_step_free(step), test.is_step_free(step)) {
                 (true, true) => out.both_free += 1,
                 (false, false) => out.both_colliding += 1,
-                (true, false) => out.overcautious_steps += 1,
+                (true, false) => {
+                    out.overcautious_steps += 1;
+                    if attribution == Attribution::FirstContact
+                        && let Ok(Some((patch, point))) = test.with_patch_map(FirstContact(step))
+                    {
+                        out.overcautious_contacts.push(UnsafeStep {
+                            index: offset + i,
+                            patch,
+                            point,
+                        });
+                    }
+                }
                 (false, true) => {
                     out.unsafe_steps += 1;
                     if attribution == Attribution::FirstContact
@@ -360,7 +388,7 @@ pub fn compare_maps<T, M>(
 ) -> Result<MapComparison, CompareError>
 where
     T: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
-    M: UnspecificStepIntersector<CapsuleStep> + Sync,
+    M: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
 {
     let steps = random_steps(sampling)?;
     Ok(compare_on_steps(truth, test, &steps, attribution))

@@ -22,7 +22,7 @@ use crate::scene_map::{
 };
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
-use patch_core::{FromPatches, Patch, Point3};
+use patch_core::{FromPatches, Patch, PatchId, Point3};
 use patch_map::mapfile::read_header;
 use patch_map::{
     AnyMap, Attribution, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap,
@@ -376,25 +376,29 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
     let spinner = progress.spinner("comparing");
     let c = compare_maps(&truth, &test, &sampling, Attribution::FirstContact)?;
     spinner.finish_and_clear();
-    let surfaces: Vec<SurfaceMisses> = c
-        .unsafe_by_patch()
-        .into_iter()
-        .take(args.surfaces)
-        .map(|(id, steps)| {
-            let patch = truth.patches().and_then(|p| p.get(id.index()));
-            SurfaceMisses {
-                patch: id.0,
-                kind: patch
-                    .map_or("?", |p| if p.as_planar().is_some() { "planar" } else { "trimesh" }),
-                area: patch.map_or(0.0, Patch::area),
-                centre: patch.map_or([0.0; 3], |p| {
-                    let c = p.bounds().center();
-                    [c.x, c.y, c.z]
-                }),
-                steps,
-            }
-        })
-        .collect();
+    let surfaces = |map: &AnyMap, counts: Vec<(PatchId, u64)>| -> Vec<SurfaceMisses> {
+        counts
+            .into_iter()
+            .take(args.surfaces)
+            .map(|(id, steps)| {
+                let patch = map.patches().and_then(|p| p.get(id.index()));
+                SurfaceMisses {
+                    patch: id.0,
+                    kind: patch.map_or("?", |p| {
+                        if p.as_planar().is_some() { "planar" } else { "trimesh" }
+                    }),
+                    area: patch.map_or(0.0, Patch::area),
+                    centre: patch.map_or([0.0; 3], |p| {
+                        let c = p.bounds().center();
+                        [c.x, c.y, c.z]
+                    }),
+                    steps,
+                }
+            })
+            .collect()
+    };
+    let misses = surfaces(&truth, c.unsafe_by_patch());
+    let blocks = surfaces(&test, c.overcautious_by_patch());
     if args.json {
         let report = serde_json::json!({
             "truth": args.truth.display().to_string(),
@@ -405,7 +409,8 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
             "truly_free": c.truly_free(),
             "unsafe": c.unsafe_rate(),
             "overcautious": c.overcautious_rate(),
-            "unsafe_by_surface": surfaces,
+            "unsafe_by_truth_surface": misses,
+            "overcautious_by_test_surface": blocks,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
@@ -435,9 +440,19 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
         "overcautious: {} (free steps the test map calls colliding)",
         c.overcautious_rate()
     )?;
-    if !surfaces.is_empty() {
-        writeln!(out, "unsafe steps by the truth surface they touch first:")?;
-        for s in &surfaces {
+    for (what, list, total) in [
+        ("unsafe steps by the truth surface they touch first", &misses, c.unsafe_steps),
+        (
+            "overcautious steps by the test-map surface they touch first",
+            &blocks,
+            c.overcautious_steps,
+        ),
+    ] {
+        if list.is_empty() {
+            continue;
+        }
+        writeln!(out, "{what}:")?;
+        for s in list {
             writeln!(
                 out,
                 "  patch {:>5} ({}, {:.2} m², centre {:.2}, {:.2}, {:.2}): {} steps ({:.1} %)",
@@ -448,7 +463,7 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
                 s.centre[1],
                 s.centre[2],
                 s.steps,
-                100.0 * s.steps as f64 / c.unsafe_steps.max(1) as f64
+                100.0 * s.steps as f64 / total.max(1) as f64
             )?;
         }
     }
