@@ -50,6 +50,9 @@ pub struct DemoResults {
     pub timing: Vec<TimingCurve>,
     /// Explored volume (Table 6.2, Fig 6.1), if computed.
     pub volume: Option<VolumeSection>,
+    /// Each map checked against the scene's exact surfaces, if computed.
+    #[serde(default)]
+    pub safety: Option<SafetySection>,
     /// Files written, relative to the output folder.
     pub files: Vec<FileEntry>,
 }
@@ -164,6 +167,37 @@ pub struct MapDrawing {
     pub triangles: Vec<[P3; 3]>,
     /// Points (world frame).
     pub points: Vec<P3>,
+}
+
+/// Is the map safe? Each map compared with the scene's exact surfaces over random capsule
+/// steps ([`patch_map::compare`]).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct SafetySection {
+    /// Random steps per map.
+    pub samples: u64,
+    /// Robot radius, metres.
+    pub radius: f64,
+    /// Longest step, metres.
+    pub max_length: f64,
+    /// The exact scene's planar outlines, for the picture.
+    pub truth: MapDrawing,
+    /// One row per map type.
+    pub rows: Vec<MapSafety>,
+}
+
+/// One map type against the truth.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct MapSafety {
+    /// Map type.
+    pub map: String,
+    /// Colliding steps the map calls free, % of truly colliding steps, with the 95 % interval.
+    pub unsafe_pct: [f64; 3],
+    /// Free steps the map calls colliding, % of truly free steps, with the 95 % interval.
+    pub overcautious_pct: [f64; 3],
+    /// Unsafe steps and truly colliding steps.
+    pub unsafe_steps: [u64; 2],
+    /// Where unsafe steps first touch the truth (decimated).
+    pub unsafe_hits: Vec<P3>,
 }
 
 /// One planning run.

@@ -34,6 +34,7 @@
 pub(crate) mod explore;
 pub(crate) mod maps;
 pub(crate) mod planning;
+pub(crate) mod safety;
 pub(crate) mod sensors;
 
 use super::model::{DemoResults, FileEntry, Scale, SceneInfo, StageTime};
@@ -78,6 +79,8 @@ pub struct Settings {
     pub plan_iterations: u64,
     /// Voxels per axis of the explored-volume grid.
     pub cells: u32,
+    /// Random capsule steps per map in the safety check.
+    pub safety_samples: usize,
 }
 
 impl Settings {
@@ -93,6 +96,7 @@ impl Settings {
                 plan_seeds: 1,
                 plan_iterations: 5000,
                 cells: 96,
+                safety_samples: 10_000,
             },
             Scale::Default => Settings {
                 scans: 8,
@@ -103,6 +107,7 @@ impl Settings {
                 plan_seeds: 4,
                 plan_iterations: 10_000,
                 cells: 256,
+                safety_samples: 50_000,
             },
             Scale::Full => Settings {
                 scans: 12,
@@ -113,6 +118,7 @@ impl Settings {
                 plan_seeds: 8,
                 plan_iterations: 20_000,
                 cells: 384,
+                safety_samples: 100_000,
             },
         }
     }
@@ -255,6 +261,11 @@ pub fn run(scale: Scale, seed: u64, out: &Path, progress: &Progress) -> Result<D
     let built = maps::build_maps(&lab, progress, &mut files)?;
     clock.lap("patch extraction and maps");
 
+    let spinner = progress.spinner("checking the maps against the scene");
+    let safety = safety::check(&lab.scene, &built, seed, &settings)?;
+    spinner.finish_and_clear();
+    clock.lap("map safety against the exact scene");
+
     let starts = planning::starts(&built)?;
     let (start, goals) = planning::plan_points(&built, &starts)?;
     let plans = planning::plan_all(&built, &start, &goals, seed, &settings, progress, &mut files)?;
@@ -283,6 +294,7 @@ pub fn run(scale: Scale, seed: u64, out: &Path, progress: &Progress) -> Result<D
         plans,
         timing,
         volume: Some(volume),
+        safety: Some(safety),
         files: files.entries,
     })
 }

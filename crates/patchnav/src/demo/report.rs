@@ -18,16 +18,17 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The section headings, in page order.
-pub const SECTIONS: [&str; 9] = [
+pub const SECTIONS: [&str; 10] = [
     "1. The run",
     "2. Map sizes",
-    "3. Planning",
-    "4. The maps",
-    "5. Explored volume",
-    "6. Time against iterations",
-    "7. Terrain",
-    "8. Time-of-flight frame",
-    "9. Files",
+    "3. Is the map safe?",
+    "4. Planning",
+    "5. The maps",
+    "6. Explored volume",
+    "7. Time against iterations",
+    "8. Terrain",
+    "9. Time-of-flight frame",
+    "10. Files",
 ];
 
 /// Width pictures are shown at, pixels.
@@ -74,12 +75,14 @@ pub fn render(results: &DemoResults) -> String {
         esc(if results.command.is_empty() { "demo" } else { &results.command })
     );
     for (i, title) in SECTIONS.iter().enumerate() {
-        let _ = write!(page, "<li><a href=\"#s{}\">{}</a></li>", i + 1, esc(&title[3..]));
+        let name = title.split_once(". ").map_or(*title, |(_, name)| name);
+        let _ = write!(page, "<li><a href=\"#s{}\">{}</a></li>", i + 1, esc(name));
     }
     page.push_str("</ol></nav>\n");
     let bodies = [
         section_run(results),
         section_maps(results),
+        section_safety(results),
         section_plans(results),
         section_pictures(results),
         section_volume(results.volume.as_ref()),
@@ -297,7 +300,7 @@ fn distinct<'a>(plans: &'a [PlanRun], key: impl Fn(&'a PlanRun) -> &'a str) -> V
     out
 }
 
-/// Section 3: planning runs.
+/// Section 4: planning runs.
 fn section_plans(r: &DemoResults) -> String {
     let mut out = String::new();
     let solved = r.plans.iter().filter(|p| p.solved).count();
@@ -377,7 +380,7 @@ fn section_plans(r: &DemoResults) -> String {
     out
 }
 
-/// Section 4: top and perspective views of each map type.
+/// Section 5: top and perspective views of each map type.
 fn section_pictures(r: &DemoResults) -> String {
     let mut out = String::new();
     out.push_str(&caption(
@@ -449,7 +452,55 @@ fn map_pictures(r: &DemoResults, d: &MapDrawing) -> String {
     out
 }
 
-/// Section 5: explored volume (Table 6.2, Fig 6.1).
+/// Section 3: each map against the exact scene, with where the unsafe steps hit.
+fn section_safety(r: &DemoResults) -> String {
+    let mut out = String::new();
+    let Some(s) = &r.safety else {
+        out.push_str(&not_computed("Map safety"));
+        return out;
+    };
+    out.push_str(&caption(&format!(
+        "The thesis judges its maps by planning on them (Tables 6.2, 6.4). A robot needs more:          a map must not call a colliding step free. Each map is compared with the scene's exact          surfaces over {} random steps of a sphere of radius {} m moved up to {} m in the room.          Unsafe: colliding steps the map calls free, of all truly colliding steps; overcautious:          free steps the map blocks, of all truly free steps; each with its 95 % Wilson interval.          The pc map's unsafe rate is the occlusion floor: what no scan saw. `patchnav experiment          map-safety` runs the same check on more scenes, noise levels and scan counts.",
+        int(s.samples),
+        fixed(s.radius, 2),
+        fixed(s.max_length, 1)
+    )));
+    let pct = |v: &[f64; 3]| format!("{} [{}, {}]", fixed(v[0], 2), fixed(v[1], 2), fixed(v[2], 2));
+    let rows: Vec<Vec<String>> = s
+        .rows
+        .iter()
+        .map(|m| {
+            vec![
+                m.map.clone(),
+                pct(&m.unsafe_pct),
+                format!("{} of {}", int(m.unsafe_steps[0]), int(m.unsafe_steps[1])),
+                pct(&m.overcautious_pct),
+            ]
+        })
+        .collect();
+    out.push_str(&table(&["map", "unsafe %", "unsafe steps", "overcautious %"], &rows));
+    let none: [&PlanRun; 0] = [];
+    let overlay = svg::Overlay { scan_positions: &r.scene.scan_positions, plans: &none };
+    for m in s.rows.iter().filter(|m| !m.unsafe_hits.is_empty()) {
+        let d = MapDrawing {
+            kind: format!("exact scene with the {} map's unsafe steps", m.map),
+            polygons: s.truth.polygons.clone(),
+            triangles: Vec::new(),
+            points: m.unsafe_hits.clone(),
+        };
+        let _ = write!(
+            out,
+            "<figure>\n{}<figcaption>The {} map: where its unsafe steps first touch the exact \
+             scene (dots, {} drawn), over the scene's planar surfaces seen from above.</figcaption>\n</figure>\n",
+            svg::top_view(&d, &overlay),
+            esc(&m.map),
+            int(m.unsafe_hits.len() as u64)
+        );
+    }
+    out
+}
+
+/// Section 6: explored volume (Table 6.2, Fig 6.1).
 fn section_volume(vol: Option<&VolumeSection>) -> String {
     let mut out = String::new();
     let largest = vol.and_then(VolumeSection::largest_difference);
@@ -584,7 +635,7 @@ fn runs_text(v: &VolumeSection) -> String {
     )
 }
 
-/// Section 6: time against iterations (Fig 6.4).
+/// Section 7: time against iterations (Fig 6.4).
 fn section_timing(r: &DemoResults) -> String {
     let mut out = String::new();
     let mut last: Vec<(f64, String)> = r
@@ -633,7 +684,7 @@ fn section_timing(r: &DemoResults) -> String {
     out
 }
 
-/// Section 7: terrain classification (Ch. 4).
+/// Section 8: terrain classification (Ch. 4).
 fn section_terrain(t: Option<&TerrainSection>) -> String {
     let mut out = String::new();
     let ours = t.map_or(String::new(), |t| {
@@ -701,7 +752,7 @@ fn section_terrain(t: Option<&TerrainSection>) -> String {
     out
 }
 
-/// Section 8: the ToF frame (§2.5).
+/// Section 9: the ToF frame (§2.5).
 fn section_tof(t: Option<&TofSection>) -> String {
     let mut out = String::new();
     let ours = t.map_or(String::new(), |t| {
@@ -802,7 +853,7 @@ fn section_tof(t: Option<&TofSection>) -> String {
     out
 }
 
-/// Section 9: the files written.
+/// Section 10: the files written.
 fn section_files(r: &DemoResults) -> String {
     let mut out = String::new();
     out.push_str(&caption(
@@ -834,6 +885,7 @@ fn section_files(r: &DemoResults) -> String {
 mod tests {
     use super::*;
     use crate::demo::model::*;
+    use crate::demo::model::{MapSafety, SafetySection};
 
     fn plan(map: &str, planner: &str, solved: bool) -> PlanRun {
         PlanRun {
@@ -968,6 +1020,27 @@ mod tests {
                 slice_size: [10, 7],
                 slice_bits: (0..70).map(|i| (i % 16) as u8).collect(),
             }),
+            safety: Some(SafetySection {
+                samples: 1000,
+                radius: 0.3,
+                max_length: 1.0,
+                truth: MapDrawing {
+                    kind: "planes".into(),
+                    polygons: vec![vec![[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 3.0, 0.0]]],
+                    triangles: Vec::new(),
+                    points: Vec::new(),
+                },
+                rows: maps
+                    .iter()
+                    .map(|m| MapSafety {
+                        map: (*m).into(),
+                        unsafe_pct: [1.0, 0.5, 1.5],
+                        overcautious_pct: [2.0, 1.5, 2.5],
+                        unsafe_steps: [4, 400],
+                        unsafe_hits: vec![[1.0, 1.0, 0.7], [2.0, 1.0, 0.0]],
+                    })
+                    .collect(),
+            }),
             files: vec![
                 FileEntry {
                     label: "hybrid map".into(),
@@ -1074,6 +1147,10 @@ mod tests {
         r.timing[0].median_ms = vec![f64::NAN, -1.0];
         r.stages[0].seconds = f64::INFINITY;
         r.drawings[0].points.push([f64::NAN, 1.0, f64::INFINITY]);
+        if let Some(s) = r.safety.as_mut() {
+            s.rows[0].unsafe_pct = [f64::NAN; 3];
+            s.rows[0].unsafe_hits.push([f64::INFINITY, 0.0, 0.0]);
+        }
         let page = render(&r);
         assert_balanced(&page);
         assert!(page.contains("Outcome picture not drawn"));

@@ -673,6 +673,7 @@ pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<Str
         plans,
         timing,
         volume,
+        safety: None,
         files: files.entries,
     };
     Ok((results, skipped))
