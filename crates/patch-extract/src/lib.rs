@@ -5,6 +5,7 @@
 //!
 //! | stage | module | thesis |
 //! |---|---|---|
+//! | mixed pixels (veil points) at depth edges, before segmentation | [`mod@mixed_pixels`] | — (ours: the shadow/veil test of PCL and ROS with line and plane support, measured in the module) |
 //! | incremental least-squares plane fit | [`plane_fit`] | §5.3.2 (orthogonal LSQ, L4624–4628) |
 //! | region growing segmentation | [`mod@segment`] | Poppinga et al. 2008, undescribed in the thesis: our method is documented in the module |
 //! | segmentation quality (SegComp, Hoover et al. 1996) | [`evaluate`] | — |
@@ -36,6 +37,7 @@ pub mod evaluate;
 pub mod grid_mesh;
 pub mod hull;
 pub mod merge;
+pub mod mixed_pixels;
 pub mod offset;
 pub mod pipeline;
 pub mod plane_fit;
@@ -49,6 +51,7 @@ pub mod simplify;
 pub mod trimesh_grow;
 
 pub use merge::{MergeConfig, merge_coplanar};
+pub use mixed_pixels::{MixedPixelConfig, mixed_pixels, remove_mixed_pixels};
 pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};

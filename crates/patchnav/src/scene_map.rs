@@ -23,7 +23,10 @@ use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Real, TrimeshPatch};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
-use patch_extract::{PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes};
+use patch_extract::{
+    MixedPixelConfig, PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes,
+    remove_mixed_pixels,
+};
 use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
 use pointcloud::{BeamModel, PointCloud};
@@ -311,15 +314,36 @@ pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
     })
 }
 
-/// Simulated ALRF scans of `scene` from [`Scene::scan_poses`], each in the world frame.
+/// Simulated ALRF scans of `scene` from [`Scene::scan_poses`], each in the world frame, as
+/// measured (the mixed-pixel filter, [`pc_points`], costs safety: see
+/// `patchnav experiment map-safety`).
 ///
 /// # Errors
 /// A bad angular step, or fewer poses than asked for.
 pub fn scan_points(scene: &Scene, setup: &ScanSetup) -> Result<Vec<Vec<Point3>>> {
-    Ok(scan_clouds(scene, setup)?
-        .into_iter()
-        .map(|cloud| cloud.to_world().positions().to_vec())
-        .collect())
+    scan_clouds(scene, setup)?
+        .iter()
+        .map(|cloud| pc_points(std::slice::from_ref(cloud), None))
+        .collect()
+}
+
+/// The points of a pc map made from `clouds` (sensor frame with poses): each organised cloud
+/// without its mixed pixels when `filter` is given, moved to the world frame.
+///
+/// # Errors
+/// The filter refusing its parameters.
+pub fn pc_points(clouds: &[PointCloud], filter: Option<&MixedPixelConfig>) -> Result<Vec<Point3>> {
+    let mut out = Vec::new();
+    for cloud in clouds {
+        match (filter, cloud.grid()) {
+            (Some(f), Some(_)) => {
+                let (kept, _) = remove_mixed_pixels(cloud, f)?;
+                out.extend_from_slice(kept.to_world().positions());
+            }
+            _ => out.extend_from_slice(cloud.to_world().positions()),
+        }
+    }
+    Ok(out)
 }
 
 /// Simulated ALRF scans of `scene` from [`Scene::scan_poses`]: organised clouds in the sensor

@@ -313,7 +313,7 @@ fn mesh_room_timing_and_volume_on_planes_and_trimesh() {
 
     // The report draws both sections.
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert!(html.contains("5. Explored volume") && html.contains("Time against iterations"));
+    assert!(html.contains("6. Explored volume") && html.contains("Time against iterations"));
     for missing in ["Explored volume: not computed", "Time against iterations: not computed"] {
         assert!(!html.contains(missing), "{missing}");
     }

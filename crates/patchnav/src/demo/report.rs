@@ -1082,8 +1082,8 @@ mod tests {
             assert!(page.contains(&format!("<h2>{}</h2>", esc(title))), "{title} missing");
         }
         assert!(!page.contains("not computed"), "every section has data");
-        // Four map types × two views + the time plot.
-        assert_eq!(page.matches("<svg").count(), 9);
+        // Four map types × two views + the time plot + four safety pictures.
+        assert_eq!(page.matches("<svg").count(), 13);
         let pngs = png_payloads(&page);
         // Hough, slice, ToF.
         assert_eq!(pngs.len(), 3);

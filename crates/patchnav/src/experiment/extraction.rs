@@ -1215,8 +1215,8 @@ fn storage_section(out: &mut String, rows: &mut Vec<Value>, cases: &[Case]) -> R
     Ok(())
 }
 
-/// Counts the bytes written.
-struct ByteCount(u64);
+/// Counts the bytes written (a map file's size without writing it).
+pub(super) struct ByteCount(pub(super) u64);
 
 impl std::io::Write for ByteCount {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {

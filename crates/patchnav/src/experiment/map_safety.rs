@@ -14,14 +14,16 @@
 //! contain a colliding edge. The tuning seed of the extraction is 0; the default step and
 //! planner seeds are 1, and the scene seed is a flag.
 
+use super::extraction::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
     MapKind, PatchBackend, ScanSetup, SceneSurfaces, Tessellation, extracted_patches, patch_map,
-    scan_clouds,
+    pc_points, scan_clouds,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_extract::MixedPixelConfig;
 use patch_map::{AnyMap, Attribution, MapComparison, PointCloudMap, StepSampling, compare_maps};
 use roadmap::{Goal, MaxIterations, PlannerKind, PlanningSpace, Problem, named_planner_on};
 use serde::Serialize;
@@ -105,17 +107,32 @@ pub struct SafetyRow {
     pub colliding_paths: u64,
 }
 
-/// Counts the bytes written.
-struct ByteCount(u64);
-
-impl std::io::Write for ByteCount {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0 += buf.len() as u64;
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
+/// A row for `map` of the cell (`scene`, `noise`, `scans`), compared with `truth`; the planner
+/// view is left empty.
+fn safety_row(
+    cell: (&str, Real, usize),
+    kind: &str,
+    truth: &AnyMap,
+    map: &AnyMap,
+    sampling: &StepSampling,
+    seconds_per_scan: Real,
+) -> Result<SafetyRow> {
+    let mut bytes = ByteCount(0);
+    map.save(&mut bytes)?;
+    Ok(SafetyRow {
+        scene: cell.0.to_owned(),
+        noise: cell.1,
+        scans: cell.2,
+        map: kind.to_owned(),
+        comparison: compare_maps(truth, map, sampling, Attribution::None)?,
+        file_bytes: bytes.0,
+        memory_bytes: map.memory_bytes(),
+        seconds_per_scan,
+        edges: 0,
+        colliding_edges: 0,
+        paths: 0,
+        colliding_paths: 0,
+    })
 }
 
 /// Runs `patchnav experiment map-safety`.
@@ -168,32 +185,19 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     let started = Instant::now();
                     let map = match extracted_patches(&clouds, kind)? {
                         Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
-                        None => {
-                            let points: Vec<Point3> = clouds
-                                .iter()
-                                .flat_map(|c| c.to_world().positions().to_vec())
-                                .collect();
-                            AnyMap::PointCloud(PointCloudMap::from_points(&points)?)
-                        }
+                        None => AnyMap::PointCloud(PointCloudMap::from_points(&pc_points(
+                            &clouds, None,
+                        )?)?),
                     };
                     let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
-                    let mut bytes = ByteCount(0);
-                    map.save(&mut bytes)?;
-                    let comparison = compare_maps(&truth, &map, &sampling, Attribution::None)?;
-                    let mut row = SafetyRow {
-                        scene: name.clone(),
-                        noise,
-                        scans,
-                        map: kind.name().to_owned(),
-                        comparison,
-                        file_bytes: bytes.0,
-                        memory_bytes: map.memory_bytes(),
+                    let mut row = safety_row(
+                        (name, noise, scans),
+                        kind.name(),
+                        &truth,
+                        &map,
+                        &sampling,
                         seconds_per_scan,
-                        edges: 0,
-                        colliding_edges: 0,
-                        paths: 0,
-                        colliding_paths: 0,
-                    };
+                    )?;
                     if args.planner_iterations > 0 {
                         planner_view(&truth, &map, args, &mut row)?;
                     }
@@ -203,6 +207,21 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                         row.comparison.overcautious_rate()
                     ));
                     rows.push(row);
+                }
+                if args.maps.contains(&MapKind::Pc) {
+                    // The pc map after the mixed-pixel filter, for its cost and benefit.
+                    let started = Instant::now();
+                    let points = pc_points(&clouds, Some(&MixedPixelConfig::alrf()))?;
+                    let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
+                    let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
+                    rows.push(safety_row(
+                        (name, noise, scans),
+                        "pc-filtered",
+                        &truth,
+                        &map,
+                        &sampling,
+                        seconds_per_scan,
+                    )?);
                 }
                 spinner.finish_and_clear();
             }
