@@ -251,9 +251,11 @@ fn lab_phantoms_go_real_surfaces_stay() {
         run(&scene_sim::lab(7).unwrap(), &Alrf::sick_s300(), 2, 7, &MixedPixelConfig::alrf(), 1);
     println!("{}", s.row("lab", 0.0));
     assert!(s.phantom > 300 && s.thin > 1000 && s.inner_floor > 500, "{s:?}");
-    assert!(s.phantom20_recall() > 0.97, "{s:?}");
-    assert!(s.phantom_recall() > 0.9, "{s:?}");
-    assert!(s.far_recall() > 0.8, "{s:?}");
+    // The foreground guard keeps phantoms next to a nearer surface (0.95 with it, 0.99
+    // without).
+    assert!(s.phantom20_recall() > 0.93, "{s:?}");
+    assert!(s.phantom_recall() > 0.88, "{s:?}");
+    assert!(s.far_recall() > 0.78, "{s:?}");
     assert!(s.clean_loss() < 0.005, "{s:?}");
     // Mostly posts 6–11 m away (one pixel wide) and legs seen by the backward beams.
     assert!(s.thin_loss() < 0.15, "{s:?}");
@@ -267,9 +269,9 @@ fn office_phantoms_go_real_surfaces_stay() {
         run(&scene_sim::office(7).unwrap(), &Alrf::sick_s300(), 2, 7, &MixedPixelConfig::alrf(), 1);
     println!("{}", s.row("office", 0.0));
     assert!(s.phantom > 100 && s.thin > 500 && s.floor > 1000, "{s:?}");
-    assert!(s.phantom20_recall() > 0.95, "{s:?}");
-    assert!(s.phantom_recall() > 0.9, "{s:?}");
-    assert!(s.far_recall() > 0.7, "{s:?}");
+    assert!(s.phantom20_recall() > 0.9, "{s:?}");
+    assert!(s.phantom_recall() > 0.85, "{s:?}");
+    assert!(s.far_recall() > 0.65, "{s:?}");
     assert!(s.clean_loss() < 0.005, "{s:?}");
     assert!(s.thin_loss() < 0.05, "{s:?}");
     assert!(s.floor_loss() < 0.02, "{s:?}");
@@ -329,7 +331,8 @@ fn thin_posts_keep_their_points() {
     assert!(total > 500, "{total}");
     assert!(kept as f64 > 0.9 * total as f64, "kept {kept} of {total}");
     assert!(phantoms > 30, "{phantoms}");
-    assert!(phantoms_removed as f64 > 0.9 * phantoms as f64, "{phantoms_removed} of {phantoms}");
+    // The foreground guard keeps the phantoms that lie just behind the post's silhouette.
+    assert!(phantoms_removed as f64 > 0.75 * phantoms as f64, "{phantoms_removed} of {phantoms}");
 }
 
 #[test]

@@ -17,12 +17,13 @@
 use crate::input::InputArgs;
 use crate::progress::Progress;
 use crate::scene_map::{
-    MapKind, MapSource, ScanSetup, SceneSurfaces, Tessellation, extracted_patches, scan_clouds,
-    scan_points,
+    MapKind, MapSource, ScanSetup, SceneSurfaces, Tessellation, extracted_patches_with, pc_points,
+    scan_clouds,
 };
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use patch_core::{FromPatches, Patch, PatchId, Point3};
+use patch_extract::{MixedPixelConfig, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
 use patch_map::{
     AnyMap, Attribution, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap,
@@ -107,6 +108,22 @@ pub struct BuildArgs {
     /// noise-free, without mixed pixels).
     #[arg(long, default_value_t = 1.0)]
     pub scan_noise: f64,
+    /// With --scene: remove mixed pixels (points on depth discontinuities) from every scan
+    /// before extraction and from the pc map (off by default: it also removes points of thin
+    /// obstacles; see docs/map-safety.md).
+    #[arg(long)]
+    pub mixed_pixels: bool,
+    /// With --mixed-pixels: a line to a grid neighbour within this angle of the beam is a
+    /// veil edge, degrees.
+    #[arg(long, default_value_t = 30.0, requires = "mixed_pixels")]
+    pub veil_angle_deg: f64,
+    /// With --mixed-pixels: range jumps up to this many metres are noise, never veil edges.
+    #[arg(long, default_value_t = 0.12, requires = "mixed_pixels")]
+    pub min_jump: f64,
+    /// With --mixed-pixels: a point within this many metres (along its beam) of the plane of
+    /// a neighbouring block is kept (0: no plane support).
+    #[arg(long, default_value_t = 0.09, requires = "mixed_pixels")]
+    pub plane_tolerance: f64,
     /// The backend of the new map.
     #[arg(long, value_enum)]
     pub backend: BackendChoice,
@@ -261,6 +278,17 @@ fn scene_source(
         seed: args.scene_seed,
         noise: args.scan_noise,
     };
+    let filter = args
+        .mixed_pixels
+        .then(|| MixedPixelConfig {
+            max_veil_angle: args.veil_angle_deg.to_radians(),
+            min_jump: args.min_jump,
+            plane_tolerance: (args.plane_tolerance > 0.0).then_some(args.plane_tolerance),
+            keep_foreground: true,
+        })
+        .map(|f| f.validate().map(|()| f))
+        .transpose()
+        .context("--mixed-pixels")?;
     let patches = match (kind, args.source) {
         (MapKind::Pc, _) => None,
         (_, MapSource::Scene) => {
@@ -269,7 +297,8 @@ fn scene_source(
         }
         (_, MapSource::Scans) => {
             let clouds = scan_clouds(&scene, &setup)?;
-            extracted_patches(&clouds, kind)
+            let pipeline = PipelineConfig { mixed_pixels: filter, ..PipelineConfig::alrf() };
+            extracted_patches_with(&clouds, kind, pipeline, TrimeshGrowConfig::alrf())
                 .with_context(|| format!("extracting the {kind} map from {} scans", args.scans))?
         }
     };
@@ -284,7 +313,7 @@ fn scene_source(
             Source::Patches(patches)
         }
         None => {
-            let points: Vec<Point3> = scan_points(&scene, &setup)?.into_iter().flatten().collect();
+            let points = pc_points(&scan_clouds(&scene, &setup)?, filter.as_ref())?;
             progress.say(format!(
                 "scene `{name}`, pc map: {} ALRF scans, {} points",
                 args.scans,
