@@ -653,7 +653,7 @@ mod tests {
         let floor = rate(&pc).unsafe_rate().value;
         let mut seen = Vec::new();
         for kind in [MapKind::Planes, MapKind::Hybrid] {
-            let patches = extracted_patches(&clouds, kind).unwrap().unwrap();
+            let patches = crate::scene_map::extracted_patches(&clouds, kind).unwrap().unwrap();
             let map = crate::scene_map::patch_map(patches, crate::scene_map::PatchBackend::Bbox6d)
                 .unwrap();
             let c = rate(&map);
