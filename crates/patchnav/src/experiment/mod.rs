@@ -7,6 +7,7 @@
 //! * `lab-volume`: explored volume and its congruence tables (§6.1.1, Tables 6.2 and 6.4);
 //! * `map-safety`: maps built from scans checked against the exact scene (unsafe and
 //!   overcautious steps, sizes, extraction time, roadmap edges re-checked);
+//! * `map-coverage`: the share of each real scan's points its planes and hybrid maps hold;
 //! * `extraction`: patch extraction quality, the outlining survey and patch sizes (§5.3,
 //!   Figs 5.12–5.14, Table 5.1).
 
@@ -16,6 +17,7 @@ use clap::Subcommand;
 
 mod extraction;
 pub(crate) mod lab;
+mod map_coverage;
 mod map_safety;
 mod office;
 mod tof;
@@ -39,6 +41,9 @@ pub enum ExperimentCommand {
     /// office at three noise levels and two scan counts, checked against the exact scene:
     /// unsafe and overcautious step rates, sizes, extraction time, roadmap edges re-checked.
     MapSafety(map_safety::MapSafetyArgs),
+    /// How much of each real scan (`--real-dir`) its planes and hybrid maps hold: the share of
+    /// points within 3σ(r) of a patch, and the maps' sizes against the scan's.
+    MapCoverage(map_coverage::MapCoverageArgs),
     /// Thesis Table 2.4: the adaptive amplitude threshold against amplitude thresholds, with
     /// unwrapping, two-frequency unwrapping and the spatial check, on six simulated scenes
     /// (and a real frame folded at a chosen non-ambiguity range with `--real`).
@@ -54,5 +59,6 @@ pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
         ExperimentCommand::Extraction(args) => extraction::run(args, progress),
         ExperimentCommand::Tof(args) => tof::run(args, progress),
         ExperimentCommand::MapSafety(args) => map_safety::run(args, progress),
+        ExperimentCommand::MapCoverage(args) => map_coverage::run(args, progress),
     }
 }
