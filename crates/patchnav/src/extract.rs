@@ -43,6 +43,9 @@ use std::path::{Path, PathBuf};
 pub enum SensorPreset {
     /// Actuated laser range finder (S300-like, 1–3 cm noise).
     Alrf,
+    /// The same sensor through the thesis's pipeline verbatim: no grazing planes, outlines as
+    /// the α-shape gives them (`PipelineConfig::alrf_thesis`).
+    AlrfThesis,
     /// Time-of-flight range camera (SR-3000-like).
     RangeCamera,
     /// Structured-light depth camera (Kinect-like): noise growing with the square of the range.
@@ -57,6 +60,7 @@ impl SensorPreset {
     pub fn configs(self) -> (PipelineConfig, TrimeshGrowConfig) {
         match self {
             SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
+            SensorPreset::AlrfThesis => (PipelineConfig::alrf_thesis(), TrimeshGrowConfig::alrf()),
             SensorPreset::RangeCamera => {
                 (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
             }
@@ -309,6 +313,7 @@ fn peak_rss_kib() -> Option<u64> {
 fn sensor_name(sensor: SensorPreset) -> &'static str {
     match sensor {
         SensorPreset::Alrf => "alrf",
+        SensorPreset::AlrfThesis => "alrf-thesis",
         SensorPreset::RangeCamera => "range-camera",
         SensorPreset::StructuredLight => "structured-light",
         SensorPreset::Exact => "exact",
