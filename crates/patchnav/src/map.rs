@@ -450,17 +450,12 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
     writeln!(out, "test:         {} ({} backend)", args.test.display(), test.backend())?;
     writeln!(
         out,
-        "steps:        {} capsules of radius {} m, up to {} m long, seed {}, in ({:.2}, {:.2}, {:.2}) .. ({:.2}, {:.2}, {:.2})",
+        "steps:        {} capsules of radius {} m, up to {} m long, seed {}, in {}",
         c.steps(),
         sampling.radius,
         sampling.max_length,
         sampling.seed,
-        b.min.x,
-        b.min.y,
-        b.min.z,
-        b.max.x,
-        b.max.y,
-        b.max.z
+        box_text(&b)
     )?;
     writeln!(out, "truth:        {} colliding, {} free", c.truly_colliding(), c.truly_free())?;
     writeln!(out, "unsafe:       {} (colliding steps the test map calls free)", c.unsafe_rate())?;
@@ -498,6 +493,14 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
     }
     print!("{out}");
     Ok(())
+}
+
+/// A box as `(x, y, z)..(x, y, z)` in centimetres' precision, for messages.
+pub(crate) fn box_text(b: &Aabb) -> String {
+    format!(
+        "({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
+        b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+    )
 }
 
 /// Unsafe steps that touch one truth surface first.

@@ -351,16 +351,7 @@ fn check_start(key: &str, start: &Point3, maps: &Maps, radius: f64) -> Result<()
     for m in &maps.built {
         let b = m.map.bounds();
         if !b.contains(start) {
-            bail!(
-                "{at} is outside the {} map's box ({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
-                m.kind,
-                b.min.x,
-                b.min.y,
-                b.min.z,
-                b.max.x,
-                b.max.y,
-                b.max.z
-            );
+            bail!("{at} is outside the {} map's box {}", m.kind, crate::map::box_text(&b));
         }
         if !CapsuleStep::sphere(*start, radius).is_ok_and(|s| m.map.is_step_free(&s)) {
             bail!(
