@@ -639,9 +639,8 @@ mod tests {
     #[test]
     fn maps_from_scans_stay_near_the_occlusion_floor() {
         let scene = scene_sim::lab(0).unwrap();
-        let t = Tessellation::lab();
         let truth = crate::scene_map::patch_map(
-            SceneSurfaces::of(&scene, &t).unwrap().patches(MapKind::Hybrid, &t).unwrap().unwrap(),
+            crate::scene_map::truth_patches(&scene).unwrap(),
             crate::scene_map::PatchBackend::Bbox6d,
         )
         .unwrap();

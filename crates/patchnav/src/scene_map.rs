@@ -261,13 +261,18 @@ pub fn build_map(
     scans: &ScanSetup,
     source: MapSource,
 ) -> Result<BuiltMap> {
+    // Scanned once, for extraction and for the pc map alike.
+    let clouds = if source == MapSource::Scans || kind == MapKind::Pc {
+        scan_clouds(scene, scans)?
+    } else {
+        Vec::new()
+    };
     let patches = match source {
         MapSource::Scene => surfaces.patches(kind, t)?,
-        MapSource::Scans => extracted_patches(&scan_clouds(scene, scans)?, kind)?,
+        MapSource::Scans => extracted_patches(&clouds, kind)?,
     };
     let Some(patches) = patches else {
-        let clouds = scan_points(scene, scans)?;
-        let points: Vec<Point3> = clouds.into_iter().flatten().collect();
+        let points = pc_points(&clouds, None)?;
         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
         return Ok(BuiltMap {
             kind,
@@ -314,21 +319,9 @@ pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
     })
 }
 
-/// Simulated ALRF scans of `scene` from [`Scene::scan_poses`], each in the world frame, as
-/// measured (the mixed-pixel filter, [`pc_points`], costs safety: see
-/// `patchnav experiment map-safety`).
-///
-/// # Errors
-/// A bad angular step, or fewer poses than asked for.
-pub fn scan_points(scene: &Scene, setup: &ScanSetup) -> Result<Vec<Vec<Point3>>> {
-    scan_clouds(scene, setup)?
-        .iter()
-        .map(|cloud| pc_points(std::slice::from_ref(cloud), None))
-        .collect()
-}
-
 /// The points of a pc map made from `clouds` (sensor frame with poses): each organised cloud
-/// without its mixed pixels when `filter` is given, moved to the world frame.
+/// without its mixed pixels when `filter` is given (the filter costs safety: see
+/// `patchnav experiment map-safety`), moved to the world frame.
 ///
 /// # Errors
 /// The filter refusing its parameters.
@@ -390,6 +383,18 @@ pub fn scan_clouds(scene: &Scene, setup: &ScanSetup) -> Result<Vec<PointCloud>> 
             })
         })
         .collect()
+}
+
+/// The scene's exact surfaces as patches (its hybrid map): the truth that maps built from
+/// scans are compared with ([`patch_map::compare`]).
+///
+/// # Errors
+/// As [`SceneSurfaces::of`].
+pub fn truth_patches(scene: &Scene) -> Result<Vec<Patch>> {
+    let t = Tessellation::lab();
+    SceneSurfaces::of(scene, &t)?
+        .patches(MapKind::Hybrid, &t)?
+        .context("the exact hybrid map has patches")
 }
 
 /// Where the patches of the planes, hybrid and trimesh maps come from.

@@ -8,11 +8,11 @@
 use crate::extract::SensorPreset;
 use crate::input::{DepthCameraChoice, InputArgs, read_cloud};
 use crate::progress::Progress;
-use crate::scene_map::{MapKind, PatchBackend, extracted_patches_with, patch_map};
+use crate::scene_map::{MapKind, extracted_patches_with};
 use anyhow::{Context, Result};
 use clap::Args;
-use patch_core::{Point3, ProximityQuery, Real};
-use patch_map::AnyMap;
+use patch_core::{FromPatches, Point3, ProximityQuery, Real};
+use patch_map::{BBox6dMap, MapFile};
 use pointcloud::PointCloud;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -120,24 +120,20 @@ impl CoverageRow {
 /// The share of `points` (world frame; `ranges` their sensor ranges) within `sigmas · σ(r)`
 /// of `map`.
 fn coverage(
-    map: &AnyMap,
+    map: &impl ProximityQuery,
     points: &[Point3],
     ranges: &[Real],
     sigma: impl Fn(Real) -> Real,
     sigmas: Real,
 ) -> Real {
-    let Some(patches) = map.patches() else { return 0.0 };
-    if points.is_empty() || patches.is_empty() {
+    if points.is_empty() {
         return 0.0;
     }
-    let covered = match map {
-        AnyMap::BBox6d(m) => points
-            .iter()
-            .zip(ranges)
-            .filter(|(p, r)| m.closest_patch(p, sigmas * sigma(**r)).is_some())
-            .count(),
-        _ => 0,
-    };
+    let covered = points
+        .iter()
+        .zip(ranges)
+        .filter(|(p, r)| map.closest_patch(p, sigmas * sigma(**r)).is_some())
+        .count();
     covered as Real / points.len() as Real
 }
 
@@ -175,7 +171,7 @@ pub fn coverage_row(
     for kind in [MapKind::Planes, MapKind::Hybrid] {
         let patches = extracted_patches_with(clouds, kind, pipeline.clone(), grow)?
             .context("patch maps have patches")?;
-        let map = patch_map(patches, PatchBackend::Bbox6d)?;
+        let map = BBox6dMap::from_patches(patches)?;
         let mut bytes = ByteCount(0);
         map.save(&mut bytes)?;
         let c = coverage(&map, world.positions(), &ranges, |r| noise.sigma(r), sigmas);

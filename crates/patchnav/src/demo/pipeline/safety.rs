@@ -7,8 +7,8 @@
 use super::maps::{Built, drawing};
 use super::{MAX_DRAWN, RADIUS, Settings, decimate, p3mm};
 use crate::demo::model::{MapSafety, SafetySection};
-use crate::scene_map::{MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map};
-use anyhow::{Context, Result};
+use crate::scene_map::{MapKind, PatchBackend, patch_map, truth_patches};
+use anyhow::Result;
 use patch_map::{Attribution, StepSampling, compare_maps};
 use scene_sim::Scene;
 
@@ -25,10 +25,7 @@ pub(crate) fn check(
     seed: u64,
     settings: &Settings,
 ) -> Result<SafetySection> {
-    let t = Tessellation::lab();
-    let truth_patches = SceneSurfaces::of(scene, &t)?
-        .patches(MapKind::Hybrid, &t)?
-        .context("the exact hybrid map has patches")?;
+    let truth_patches = truth_patches(scene)?;
     let truth_drawing = drawing(MapKind::Planes, &truth_patches);
     let truth = patch_map(truth_patches, PatchBackend::Bbox6d)?;
     let sampling = StepSampling {
