@@ -85,9 +85,15 @@ impl PolygonizeConfig {
     }
 
     /// [`PolygonizeConfig::thesis`] with outlines grown by [`OutlineOffset::alrf`], so patches
-    /// cover the surface between and beyond their outermost points (not in the thesis).
+    /// cover the surface between and beyond their outermost points, and the robust α
+    /// ([`AlphaShapeConfig::robust`]), so a few stray points do not stretch them across gaps
+    /// (neither is in the thesis).
     pub fn conservative() -> PolygonizeConfig {
-        PolygonizeConfig { offset: Some(OutlineOffset::alrf()), ..PolygonizeConfig::thesis() }
+        PolygonizeConfig {
+            outline: OutlineMethod::AlphaShape(AlphaShapeConfig::robust()),
+            offset: Some(OutlineOffset::alrf()),
+            ..PolygonizeConfig::thesis()
+        }
     }
 
     /// The thesis's pipeline with a different Douglas–Peucker ε (e.g. 3 cm for noisier

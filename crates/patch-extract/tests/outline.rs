@@ -5,8 +5,8 @@ use patch_core::na;
 use patch_core::{Isometry3, Plane, PlaneCovariance, Point2, Point3, Polygon, Real, Vector3};
 use patch_extract::PlanarRegion;
 use patch_extract::alpha_shape::{
-    AlphaChoice, AlphaShapeConfig, AlphaShapeError, ComponentPolicy, HoleFilter, alpha_shape,
-    optimal_alpha,
+    AlphaChoice, AlphaShapeConfig, AlphaShapeError, ComponentPolicy, HoleFilter,
+    ROBUST_MAX_UNCOVERED, alpha_shape, optimal_alpha,
 };
 use patch_extract::hull::{HullError, convex_hull, convex_hull_polygon};
 use patch_extract::polygonize::{
@@ -627,4 +627,32 @@ fn measure_region_to_patch() {
         out.patches[0].area(),
         triangle_count(&out.patches[0]).unwrap(),
     );
+}
+
+/// A square of points and two stray points a metre away: the optimal α must reach them and
+/// bridges the gap; the robust α leaves them out and keeps the square's own spacing.
+#[test]
+fn robust_alpha_leaves_stray_points_out() {
+    let mut points = jittered_grid((0.0, 1.0), (0.0, 1.0), 0.05, 5, |_| true);
+    let n = points.len();
+    points.extend([Point2::new(2.0, 0.5), Point2::new(2.05, 0.55)]);
+    let optimal = optimal_alpha(&points, 1).unwrap();
+    assert!(optimal > 0.4, "the optimal α bridges the 1 m gap: {optimal}");
+    let robust = alpha_shape(&points, &AlphaShapeConfig::robust()).unwrap();
+    assert!(2.0 / points.len() as Real <= ROBUST_MAX_UNCOVERED, "{n} points");
+    assert!(robust.alpha < 0.1, "α = {}", robust.alpha);
+    assert_eq!(robust.polygons.len(), 1);
+    let area = robust.polygons[0].area();
+    assert!((0.85..=1.0).contains(&area), "the square alone: {area} m²");
+    // Parameters out of range are typed errors.
+    for (max_components, max_uncovered) in [(0, 0.02), (1, 1.0), (1, -0.1), (1, Real::NAN)] {
+        let config = AlphaShapeConfig {
+            alpha: AlphaChoice::Robust { max_components, max_uncovered },
+            ..AlphaShapeConfig::robust()
+        };
+        assert!(
+            matches!(alpha_shape(&points, &config), Err(AlphaShapeError::InvalidAlpha { .. })),
+            "{max_components} {max_uncovered}"
+        );
+    }
 }

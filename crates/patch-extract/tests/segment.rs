@@ -278,7 +278,15 @@ fn bad_configs_are_errors() {
     negative.distance_factor = -1.0;
     let mut jump = base;
     jump.jump_relative = Real::INFINITY;
-    for bad in [nan, negative, jump] {
+    let mut normal = base;
+    normal.max_normal_angle = Some(2.0);
+    let mut zero_normal = base;
+    zero_normal.max_normal_angle = Some(0.0);
+    let mut link = SegmentConfig::alrf();
+    if let Some(g) = link.grazing.as_mut() {
+        g.link_cos = Real::NAN;
+    }
+    for bad in [nan, negative, jump, normal, zero_normal, link] {
         assert!(matches!(segment(&cloud, &bad), Err(SegmentError::BadParameter { .. })));
         assert!(bad.validate().is_err());
     }

@@ -167,6 +167,10 @@ pub struct CompareArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also write every disagreement as CSV (`kind,step,patch,x,y,z`: `unsafe` rows name the
+    /// truth patch and point a step touches first, `overcautious` rows the test map's).
+    #[arg(long)]
+    pub contacts: Option<PathBuf>,
 }
 
 fn parse_box(text: &str) -> Result<Aabb, String> {
@@ -426,6 +430,18 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
             })
             .collect()
     };
+    if let Some(path) = &args.contacts {
+        let mut csv = String::from("kind,step,patch,x,y,z\n");
+        for (kind, list) in
+            [("unsafe", &c.unsafe_contacts), ("overcautious", &c.overcautious_contacts)]
+        {
+            for s in list {
+                let p = s.point;
+                writeln!(csv, "{kind},{},{},{},{},{}", s.index, s.patch.0, p.x, p.y, p.z)?;
+            }
+        }
+        std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;
+    }
     let misses = surfaces(&truth, c.unsafe_by_patch());
     let blocks = surfaces(&test, c.overcautious_by_patch());
     if args.json {
@@ -622,8 +638,12 @@ mod tests {
         // The command runs with every option, text and JSON.
         let cmd = ["map", "compare", &path("exact.pmap"), &path("scan.pmap"), "--samples", "500"];
         run(&cli(&cmd).unwrap(), &Progress::new(true)).unwrap();
-        let boxed = [&cmd[..], &["--box", "-1,0,0,12,9,2", "--json", "--radius", "0.2"]].concat();
+        let csv = path("c.csv");
+        let extra = ["--box", "-1,0,0,12,9,2", "--json", "--radius", "0.2", "--contacts", &csv];
+        let boxed = [&cmd[..], &extra[..]].concat();
         run(&cli(&boxed).unwrap(), &Progress::new(true)).unwrap();
+        let csv = std::fs::read_to_string(&csv).unwrap();
+        assert!(csv.starts_with("kind,step,patch,x,y,z\n") && csv.lines().count() > 1, "{csv}");
         for bad in [&["--box", "1,2,3"][..], &["--box", "0,0,0,-1,1,1"], &["--samples", "x"]] {
             assert!(cli(&[&cmd[..], bad].concat()).is_err(), "{bad:?}");
         }
