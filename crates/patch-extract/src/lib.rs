@@ -1,7 +1,8 @@
 //! Planar patches from range data (thesis §5.3, spec §2): plane segmentation of organised and
 //! unorganised scans, projection of the regions onto their planes, outlines and
 //! triangulations of the thesis's survey, outline simplification, trimesh growing for the
-//! non-planar remainder, and outline merging across scans; [`pipeline::extract`] runs them all.
+//! non-planar remainder (of unorganised scans too, through a spherical grid), and outline
+//! merging across scans; [`pipeline::extract`] runs them all.
 //!
 //! | stage | module | thesis |
 //! |---|---|---|
@@ -19,6 +20,7 @@
 //! | region → planar patch (projection, α-shape, DP) | [`polygonize`] | Ch.6 pipeline, L5341–5343 |
 //! | spikyness, mesh statistics, outline fidelity | [`quality`] | L5148–5154 |
 //! | trimesh growing (Alg 4 and 5) | [`trimesh_grow`] | L4484–4620 |
+//! | spherical range-image grids, so unorganised scans' remainders are meshed too | [`spherical_grid`] | — (ours: the thesis's hybrid maps mesh organised scans only, §6.1) |
 //! | outline merging across scans | [`merge`] | §5.1 |
 //! | conservative outline offset | [`offset`] | — (ours) |
 //! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
@@ -48,6 +50,7 @@ pub mod region;
 pub mod scanline;
 pub mod segment;
 pub mod simplify;
+pub mod spherical_grid;
 pub mod trimesh_grow;
 
 pub use merge::{MergeConfig, merge_coplanar};
@@ -56,4 +59,5 @@ pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
 pub use segment::{GrazingPlanes, SegmentConfig, segment};
+pub use spherical_grid::{SphericalGrid, SphericalGridConfig};
 pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};

@@ -7,8 +7,10 @@
 //!
 //! Scans are organised or unorganised [`PointCloud`]s **in their sensor frame** with their
 //! [`PointCloud::sensor_pose`] set (as range images and simulated scans give them); a cloud
-//! without a pose is taken as a scan from the world origin. Trimesh growing needs the pixel
-//! grid, so the remainder of an unorganised scan is reported but not meshed.
+//! without a pose is taken as a scan from the world origin. Trimesh growing needs a pixel
+//! grid: the remainder of an unorganised scan is binned into a spherical range-image grid
+//! around its sensor first ([`crate::spherical_grid`], an addition beyond the thesis, whose
+//! hybrid maps mesh organised scans only), when [`PipelineConfig::unorganised`] asks for it.
 //!
 //! A region that polygonisation refuses (too few distinct points after projection, a degenerate
 //! outline) is counted in [`ScanReport::failed_regions`] with its reason in
@@ -21,7 +23,8 @@ use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
 use crate::polygonize::{PolygonizeConfig, polygonize_region};
 use crate::segment::{SegmentConfig, SegmentError, segment};
-use crate::trimesh_grow::{TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
+use crate::spherical_grid::{SphericalGridConfig, SphericalGridError, mesh_unorganised};
+use crate::trimesh_grow::{GrownTrimeshes, TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
 use patch_core::{Isometry3, Patch, PlanarPatch};
 use pointcloud::PointCloud;
 use std::time::{Duration, Instant};
@@ -38,9 +41,14 @@ pub struct PipelineConfig {
     /// Outline merging across scans; `None`: every scan's patches are kept as they are.
     pub merge: Option<MergeConfig>,
     /// Mixed pixels removed from each organised scan before segmentation
-    /// ([`crate::mixed_pixels`]); `None`: scans are segmented as they are (the thesis).
+    /// ([`mod@crate::mixed_pixels`]); `None`: scans are segmented as they are (the thesis).
     /// Unorganised scans are never filtered.
     pub mixed_pixels: Option<MixedPixelConfig>,
+    /// With `remainder`: how the remainder of an unorganised scan gets the pixel grid trimesh
+    /// growing needs ([`crate::spherical_grid`], an addition beyond the thesis); `None`: the
+    /// remainder of unorganised scans is not meshed (organised scans are meshed either way).
+    /// Every preset sets [`SphericalGridConfig::estimated`].
+    pub unorganised: Option<SphericalGridConfig>,
 }
 
 impl PipelineConfig {
@@ -56,6 +64,7 @@ impl PipelineConfig {
             remainder: None,
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
+            unorganised: Some(SphericalGridConfig::estimated()),
         }
     }
 
@@ -79,6 +88,7 @@ impl PipelineConfig {
             remainder: None,
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
+            unorganised: Some(SphericalGridConfig::estimated()),
         }
     }
 
@@ -91,6 +101,7 @@ impl PipelineConfig {
             remainder: None,
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
+            unorganised: Some(SphericalGridConfig::estimated()),
         }
     }
 
@@ -103,6 +114,7 @@ impl PipelineConfig {
             remainder: None,
             merge: Some(MergeConfig::exact()),
             mixed_pixels: None,
+            unorganised: Some(SphericalGridConfig::estimated()),
         }
     }
 
@@ -123,6 +135,15 @@ pub enum ExtractError {
         scan: usize,
         /// The reason.
         source: SegmentError,
+    },
+    /// The spherical grid of an unorganised scan (or trimesh growing on it) refused its
+    /// parameters.
+    #[error("scan {scan}: spherical grid: {source}")]
+    SphericalGrid {
+        /// Index of the scan.
+        scan: usize,
+        /// The reason.
+        source: SphericalGridError,
     },
     /// Trimesh growing refused its parameters.
     #[error("scan {scan}: trimesh growing: {source}")]
@@ -172,6 +193,15 @@ pub struct ScanReport {
     pub mixed_pixels: usize,
     /// Trimesh patches grown on the remainder.
     pub trimesh_patches: usize,
+    /// Remainder points of an unorganised scan that got a cell of its spherical grid (the
+    /// others shared a cell with a nearer point, or lay nearer than its `min_range`); 0 for
+    /// organised scans.
+    pub binned_remainder: usize,
+    /// Splats (one triangle each) for remainder points of an unorganised scan that no grown
+    /// mesh holds ([`crate::spherical_grid::mesh_unorganised`]). They and the grown meshes
+    /// smaller than the grow config's `min_triangles` are grouped into trimesh patches of
+    /// their own in [`Extraction::patches`], not counted in `trimesh_patches`.
+    pub splats: usize,
     /// Outline vertices before and after simplification, summed over the regions.
     pub outline_vertices: (usize, usize),
 }
@@ -201,7 +231,8 @@ impl StageTimes {
 /// The patches of a set of scans, in the world frame, and how they were made.
 #[derive(Clone, Debug, Default)]
 pub struct Extraction {
-    /// Planar patches first (merged if asked), then the trimesh patches.
+    /// Planar patches first (merged if asked), then the trimesh patches (per scan: the grown
+    /// meshes, then an unorganised scan's groups of splats and small meshes).
     pub patches: Vec<Patch>,
     /// One report per scan.
     pub scans: Vec<ScanReport>,
@@ -272,14 +303,39 @@ pub fn extract(
         }
         out.times.polygonization += t.elapsed();
 
-        if let (Some(grow), Some(grid)) = (&config.remainder, scan.grid()) {
+        if let Some(grow) = &config.remainder {
             let t = Instant::now();
-            let mask = RegionMask::from_points(grid, &segmentation.remainder);
-            let grown = grow_trimeshes_in(scan, &mask, grow)
-                .map_err(|source| ExtractError::Trimesh { scan: index, source })?;
+            let mut scattered = Vec::new();
+            let grown = match (scan.grid(), &config.unorganised) {
+                (Some(grid), _) => {
+                    let mask = RegionMask::from_points(grid, &segmentation.remainder);
+                    grow_trimeshes_in(scan, &mask, grow)
+                        .map_err(|source| ExtractError::Trimesh { scan: index, source })?
+                }
+                (None, Some(spherical)) => {
+                    let noise = config.segment.noise;
+                    let made = mesh_unorganised(
+                        scan.positions(),
+                        &segmentation.remainder,
+                        spherical,
+                        grow,
+                        &|r| noise.sigma(r),
+                    )
+                    .map_err(|source| ExtractError::SphericalGrid { scan: index, source })?;
+                    report.binned_remainder = made.binned;
+                    report.splats = made.splat_triangles;
+                    scattered = made.scattered;
+                    made.grown
+                }
+                (None, None) => GrownTrimeshes::default(),
+            };
             report.trimesh_patches = grown.meshes.len();
             meshes.extend(
-                grown.into_patches().into_iter().map(|m| Patch::Trimesh(m.transformed(&motion))),
+                grown
+                    .into_patches()
+                    .into_iter()
+                    .chain(scattered)
+                    .map(|m| Patch::Trimesh(m.transformed(&motion))),
             );
             out.times.trimesh += t.elapsed();
         }

@@ -23,7 +23,8 @@
 //! first), triangles that are degenerate in 3D are never accepted (a [`TrimeshPatch`] refuses
 //! them), and meshes above `max_triangles` are cut into consecutive runs of their
 //! breadth-first order (spatially compact pieces; the thesis's Lab dataset averaged about 324
-//! triangles per trimesh patch).
+//! triangles per trimesh patch), and optionally side limits that grow with range
+//! ([`TrimeshGrowConfig::side_per_range`]).
 //!
 //! `d ≥ 0` orients normals towards the origin, so run this on clouds in the sensor frame (as
 //! scanned), where the origin is the sensor.
@@ -78,6 +79,14 @@ pub struct TrimeshGrowConfig {
     /// pixels on both sides contain points of both surfaces, so their fitted planes agree and
     /// Alg 4 alone would bridge the jump. `None` is Alg 4 as printed.
     pub phase1_max_side: Option<Real>,
+    /// Addition for sparse scans (spinning lidars, whose neighbouring beams are `r · Δ`
+    /// apart): when set to `k`, both side limits (`θ_s` and `phase1_max_side`) are multiplied
+    /// by `max(1, k · r / θ_s)`, `r` the distance of the side's nearer end from the origin
+    /// (the sensor, for clouds in the sensor frame): phase 2 accepts a side below
+    /// `max(θ_s, k · r)`. `None` (the named constructors) keeps the fixed limits.
+    /// [`crate::spherical_grid::SphericalGridConfig::max_side_steps`] sets it from the grid's
+    /// angular step for unorganised scans.
+    pub side_per_range: Option<Real>,
     /// Meshes with fewer triangles are dropped.
     pub min_triangles: usize,
     /// Meshes with more triangles are cut into pieces of at most this many.
@@ -85,7 +94,7 @@ pub struct TrimeshGrowConfig {
 }
 
 impl TrimeshGrowConfig {
-    /// A validated configuration.
+    /// A validated configuration (with fixed side limits: `side_per_range` `None`).
     ///
     /// # Errors
     /// [`TrimeshGrowError::BadThreshold`], [`TrimeshGrowError::TriangleLimits`].
@@ -102,6 +111,7 @@ impl TrimeshGrowConfig {
             max_offset_diff,
             max_side,
             phase1_max_side,
+            side_per_range: None,
             min_triangles,
             max_triangles,
         };
@@ -119,6 +129,7 @@ impl TrimeshGrowConfig {
             ("max_offset_diff", self.max_offset_diff),
             ("max_side", self.max_side),
             ("phase1_max_side", self.phase1_max_side.unwrap_or(1.0)),
+            ("side_per_range", self.side_per_range.unwrap_or(1.0)),
         ];
         for (name, value) in checks {
             let too_big = name == "max_normal_angle" && value > std::f64::consts::PI;
@@ -151,6 +162,7 @@ impl TrimeshGrowConfig {
             max_offset_diff: 0.30,
             max_side: 0.10,
             phase1_max_side: Some(0.20),
+            side_per_range: None,
             min_triangles: 4,
             max_triangles: 1000,
         }
@@ -168,6 +180,7 @@ impl TrimeshGrowConfig {
             max_offset_diff: 0.50,
             max_side: 0.30,
             phase1_max_side: Some(0.60),
+            side_per_range: None,
             min_triangles: 4,
             max_triangles: 1000,
         }
@@ -340,7 +353,13 @@ pub fn grow_trimeshes_in(
     let sides_below = |t: usize, limit: Real| -> bool {
         let Some(p) = tri_points(t) else { return false };
         let (s0, s1) = if t.is_multiple_of(2) { ((0, 1), (0, 2)) } else { ((0, 2), (1, 2)) };
-        (p[s0.0] - p[s0.1]).norm() < limit && (p[s1.0] - p[s1.1]).norm() < limit
+        let below = |(a, b): (usize, usize)| {
+            let scale = config.side_per_range.map_or(1.0, |k| {
+                (k * p[a].coords.norm().min(p[b].coords.norm()) / config.max_side).max(1.0)
+            });
+            (p[a] - p[b]).norm() < limit * scale
+        };
+        below(s0) && below(s1)
     };
     let short_sides = |t: usize| sides_below(t, config.max_side);
 

@@ -130,6 +130,46 @@ fn hybrid_maps_add_world_trimeshes_for_the_remainder() {
     }
 }
 
+/// Unorganised scans (the same frames without their pixel grid) get remainder meshes too,
+/// through the spherical grid (not in the thesis); `unorganised: None` keeps the old
+/// behaviour (planes only), and bad spherical-grid parameters are errors.
+#[test]
+fn hybrid_maps_of_unorganised_scans_mesh_the_remainder_too() {
+    let scans: Vec<PointCloud> = scans()
+        .into_iter()
+        .map(|mut s| {
+            s.set_grid(None).unwrap();
+            s
+        })
+        .collect();
+    let config = PipelineConfig::range_camera().with_remainder(TrimeshGrowConfig::range_camera());
+    let out = extract(&scans, &config, |_| {}).unwrap();
+    for r in &out.scans {
+        assert!(r.remainder_points > 0);
+        assert!(r.trimesh_patches > 0, "{r:?}");
+        assert!(r.binned_remainder > 0 && r.binned_remainder <= r.remainder_points, "{r:?}");
+    }
+    let meshes: Vec<_> = out.patches.iter().filter_map(Patch::as_trimesh).collect();
+    assert!(!meshes.is_empty());
+    for m in &meshes {
+        for v in m.vertices() {
+            assert!(v.z > -0.2 && v.z < 3.2 && v.x > -1.2 && v.x < 5.2, "{v}");
+        }
+    }
+
+    let planes_only = PipelineConfig { unorganised: None, ..config.clone() };
+    let out = extract(&scans, &planes_only, |_| {}).unwrap();
+    assert!(out.patches.iter().all(|p| p.as_trimesh().is_none()));
+    assert!(out.scans.iter().all(|r| r.trimesh_patches == 0 && r.splats == 0));
+
+    let mut bad = config;
+    if let Some(grid) = &mut bad.unorganised {
+        grid.max_side_steps = Some(Real::NAN);
+    }
+    let err = extract(&scans, &bad, |_| {}).unwrap_err();
+    assert!(matches!(err, ExtractError::SphericalGrid { scan: 0, .. }), "{err}");
+}
+
 #[test]
 fn empty_scans_bad_poses_and_bad_parameters() {
     let out = extract(&[], &PipelineConfig::exact(), |_| {}).unwrap();

@@ -90,7 +90,9 @@ pub struct ExtractArgs {
     /// Threshold presets (segmentation noise model, trimesh growing, merging tolerances).
     #[arg(long, value_enum, default_value_t = SensorPreset::Alrf)]
     pub sensor: SensorPreset,
-    /// Also grow trimesh patches on the points in no plane (the thesis's hybrid map).
+    /// Also grow trimesh patches on the points in no plane (the thesis's hybrid map); for
+    /// unorganised scans through a spherical range-image grid, with splats for the points no
+    /// mesh holds (`patch_extract::spherical_grid`, not in the thesis).
     #[arg(long)]
     pub hybrid: bool,
     /// Keep every scan's patches instead of merging coplanar overlapping ones.
@@ -238,6 +240,13 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
             r.outline_vertices.0,
             r.outline_vertices.1
         )?;
+        if r.binned_remainder > 0 {
+            writeln!(
+                out,
+                "    unorganised: {} remainder points binned into its spherical grid, {} splats",
+                r.binned_remainder, r.splats
+            )?;
+        }
         for reason in &r.failures {
             writeln!(out, "    failed region: {reason}")?;
         }
