@@ -22,6 +22,7 @@
 //! | trimesh growing (Alg 4 and 5) | [`trimesh_grow`] | L4484–4620 |
 //! | spherical range-image grids, so unorganised scans' remainders are meshed too | [`spherical_grid`] | — (ours: the thesis's hybrid maps mesh organised scans only, §6.1) |
 //! | outline merging across scans | [`merge`] | §5.1 |
+//! | range denoising along the beams (trimesh, hybrid and point-cloud maps) | [`denoise`] | — (ours) |
 //! | conservative outline offset | [`offset`] | — (ours) |
 //! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
 //!
@@ -35,6 +36,7 @@
 
 pub mod alpha_shape;
 pub mod chain_code;
+pub mod denoise;
 pub mod evaluate;
 pub mod grid_mesh;
 pub mod hull;

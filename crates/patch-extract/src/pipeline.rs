@@ -18,6 +18,7 @@
 //! should first drop the ±90° columns ([`crate::projection::invalidate_alrf_side_columns`],
 //! thesis App. A), which needs the scan's beam model and so is the caller's step.
 
+use crate::denoise::{BeamDenoiseConfig, DenoiseError, denoise_along_beams};
 use crate::grid_mesh::RegionMask;
 use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
@@ -49,6 +50,10 @@ pub struct PipelineConfig {
     /// remainder of unorganised scans is not meshed (organised scans are meshed either way).
     /// Every preset sets [`SphericalGridConfig::estimated`].
     pub unorganised: Option<SphericalGridConfig>,
+    /// With `remainder`: each organised scan denoised along its beams before its remainder is
+    /// meshed ([`crate::denoise`], not in the thesis); `None`: meshed as measured. Planar
+    /// regions fit their planes to the raw points either way.
+    pub denoise: Option<BeamDenoiseConfig>,
 }
 
 impl PipelineConfig {
@@ -65,16 +70,19 @@ impl PipelineConfig {
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
             unorganised: Some(SphericalGridConfig::estimated()),
+            denoise: Some(BeamDenoiseConfig::alrf()),
         }
     }
 
     /// The ALRF pipeline as the thesis describes it: no mixed-pixel filter, the strict
     /// incidence test ([`SegmentConfig::alrf`] without [`crate::GrazingPlanes`]), α-shape
-    /// outlines as found ([`PolygonizeConfig::thesis`]); for reproducing the thesis's tables.
+    /// outlines as found ([`PolygonizeConfig::thesis`]), remainders meshed as measured; for
+    /// reproducing the thesis's tables.
     pub fn alrf_thesis() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig { grazing: None, ..SegmentConfig::alrf() },
             polygonize: PolygonizeConfig::thesis(),
+            denoise: None,
             ..PipelineConfig::alrf()
         }
     }
@@ -89,6 +97,7 @@ impl PipelineConfig {
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
             unorganised: Some(SphericalGridConfig::estimated()),
+            denoise: None,
         }
     }
 
@@ -102,6 +111,7 @@ impl PipelineConfig {
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
             unorganised: Some(SphericalGridConfig::estimated()),
+            denoise: None,
         }
     }
 
@@ -115,6 +125,7 @@ impl PipelineConfig {
             merge: Some(MergeConfig::exact()),
             mixed_pixels: None,
             unorganised: Some(SphericalGridConfig::estimated()),
+            denoise: None,
         }
     }
 
@@ -156,6 +167,14 @@ pub enum ExtractError {
     /// Merging refused its parameters.
     #[error("merging: {0}")]
     Merge(#[from] MergeError),
+    /// Beam denoising refused its parameters.
+    #[error("scan {scan}: beam denoising: {source}")]
+    Denoise {
+        /// Index of the scan.
+        scan: usize,
+        /// The reason.
+        source: DenoiseError,
+    },
     /// The mixed-pixel filter refused its parameters.
     #[error("scan {scan}: mixed-pixel filter: {source}")]
     MixedPixels {
@@ -309,6 +328,16 @@ pub fn extract(
             let grown = match (scan.grid(), &config.unorganised) {
                 (Some(grid), _) => {
                     let mask = RegionMask::from_points(grid, &segmentation.remainder);
+                    let denoised;
+                    let scan = match &config.denoise {
+                        Some(d) => {
+                            denoised = denoise_along_beams(scan, d)
+                                .map_err(|source| ExtractError::Denoise { scan: index, source })?
+                                .0;
+                            &denoised
+                        }
+                        None => scan,
+                    };
                     grow_trimeshes_in(scan, &mask, grow)
                         .map_err(|source| ExtractError::Trimesh { scan: index, source })?
                 }

@@ -422,14 +422,14 @@ impl SegmentConfig {
         non_negative("jump_relative", self.jump_relative)?;
         non_negative("seed_min_extent", self.seed_min_extent)?;
         positive("knn_radius", self.knn_radius)?;
-        if let Some(a) = self.max_normal_angle {
-            if !(a > 0.0 && a <= std::f64::consts::FRAC_PI_2) {
-                return Err(SegmentError::BadParameter {
-                    name: "max_normal_angle",
-                    value: a,
-                    allowed: "in (0, π/2] radians",
-                });
-            }
+        if let Some(a) = self.max_normal_angle
+            && !(a > 0.0 && a <= std::f64::consts::FRAC_PI_2)
+        {
+            return Err(SegmentError::BadParameter {
+                name: "max_normal_angle",
+                value: a,
+                allowed: "in (0, π/2] radians",
+            });
         }
         if let Some(b) = self.max_bending {
             positive("max_bending", b)?;

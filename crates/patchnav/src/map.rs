@@ -23,6 +23,7 @@ use crate::scene_map::{
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use patch_core::{FromPatches, Patch, PatchId, Point3};
+use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
 use patch_map::{
@@ -124,6 +125,11 @@ pub struct BuildArgs {
     /// a neighbouring block is kept (0: no plane support).
     #[arg(long, default_value_t = 0.09, requires = "mixed_pixels")]
     pub plane_tolerance: f64,
+    /// With --scene --kind pc: move every scan's locally planar points along their beams onto
+    /// their neighbourhood's plane (the trimesh and hybrid maps always are; see
+    /// docs/map-safety.md). Off by default: the raw pc map is the occlusion floor.
+    #[arg(long)]
+    pub denoise: bool,
     /// The backend of the new map.
     #[arg(long, value_enum)]
     pub backend: BackendChoice,
@@ -317,7 +323,11 @@ fn scene_source(
             Source::Patches(patches)
         }
         None => {
-            let points = pc_points(&scan_clouds(&scene, &setup)?, filter.as_ref())?;
+            let points = pc_points(
+                &scan_clouds(&scene, &setup)?,
+                filter.as_ref(),
+                args.denoise.then(BeamDenoiseConfig::alrf).as_ref(),
+            )?;
             progress.say(format!(
                 "scene `{name}`, pc map: {} ALRF scans, {} points",
                 args.scans,
@@ -669,7 +679,7 @@ mod tests {
         let s = StepSampling { samples: 20_000, seed: 5, ..StepSampling::in_box(truth.bounds()) };
         let rate = |map: &AnyMap| compare_maps(&truth, map, &s, Attribution::None).unwrap();
         let pc = AnyMap::PointCloud(
-            PointCloudMap::from_points(&crate::scene_map::pc_points(&clouds, None).unwrap())
+            PointCloudMap::from_points(&crate::scene_map::pc_points(&clouds, None, None).unwrap())
                 .unwrap(),
         );
         let floor = rate(&pc).unsafe_rate().value;

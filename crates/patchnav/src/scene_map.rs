@@ -22,6 +22,7 @@
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Real, TrimeshPatch};
+use patch_extract::denoise::{BeamDenoiseConfig, denoise_along_beams};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
 use patch_extract::{
     MixedPixelConfig, PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes,
@@ -272,7 +273,7 @@ pub fn build_map(
         MapSource::Scans => extracted_patches(&clouds, kind)?,
     };
     let Some(patches) = patches else {
-        let points = pc_points(&clouds, None)?;
+        let points = pc_points(&clouds, None, None)?;
         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
         return Ok(BuiltMap {
             kind,
@@ -321,19 +322,32 @@ pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
 
 /// The points of a pc map made from `clouds` (sensor frame with poses): each organised cloud
 /// without its mixed pixels when `filter` is given (the filter costs safety: see
-/// `patchnav experiment map-safety`), moved to the world frame.
+/// `patchnav experiment map-safety`), then denoised along its beams when `denoise` is given,
+/// moved to the world frame.
 ///
 /// # Errors
-/// The filter refusing its parameters.
-pub fn pc_points(clouds: &[PointCloud], filter: Option<&MixedPixelConfig>) -> Result<Vec<Point3>> {
+/// The filter or the denoising refusing its parameters.
+pub fn pc_points(
+    clouds: &[PointCloud],
+    filter: Option<&MixedPixelConfig>,
+    denoise: Option<&BeamDenoiseConfig>,
+) -> Result<Vec<Point3>> {
     let mut out = Vec::new();
     for cloud in clouds {
-        match (filter, cloud.grid()) {
-            (Some(f), Some(_)) => {
-                let (kept, _) = remove_mixed_pixels(cloud, f)?;
-                out.extend_from_slice(kept.to_world().positions());
+        if cloud.grid().is_none() {
+            out.extend_from_slice(cloud.to_world().positions());
+            continue;
+        }
+        let filtered = match filter {
+            Some(f) => Some(remove_mixed_pixels(cloud, f)?.0),
+            None => None,
+        };
+        let cloud = filtered.as_ref().unwrap_or(cloud);
+        match denoise {
+            Some(d) => {
+                out.extend_from_slice(denoise_along_beams(cloud, d)?.0.to_world().positions())
             }
-            _ => out.extend_from_slice(cloud.to_world().positions()),
+            None => out.extend_from_slice(cloud.to_world().positions()),
         }
     }
     Ok(out)
@@ -431,6 +445,14 @@ pub fn extracted_patches_with(
                 let motion = cloud
                     .sensor_pose()
                     .map_or_else(Isometry3::identity, |pose| pose.world_from_sensor);
+                let denoised;
+                let cloud = match (&pipeline.denoise, cloud.grid()) {
+                    (Some(d), Some(_)) => {
+                        denoised = denoise_along_beams(cloud, d)?.0;
+                        &denoised
+                    }
+                    _ => cloud,
+                };
                 let grown = grow_trimeshes(cloud, &grow)?;
                 patches.extend(
                     grown

@@ -439,6 +439,20 @@ impl PointCloud {
         out
     }
 
+    /// This cloud with its points moved to `positions` (one per point, all finite), every
+    /// attribute, the grid and the pose kept.
+    ///
+    /// # Errors
+    /// [`AttributeError::Length`] for a wrong count, [`AttributeError::NonFinite`].
+    pub fn with_positions(&self, positions: Vec<Point3>) -> Result<PointCloud, AttributeError> {
+        check_len("positions", positions.len(), self.len())?;
+        if let Some(index) = positions.iter().position(|p| !p.coords.iter().all(|v| v.is_finite()))
+        {
+            return Err(AttributeError::NonFinite { index });
+        }
+        Ok(PointCloud { positions, ..self.clone() })
+    }
+
     /// Keeps the points for which `keep(index)` is true, with all their attributes. The grid
     /// marks the pixels of dropped points invalid.
     pub fn retain_indices(&self, mut keep: impl FnMut(usize) -> bool) -> PointCloud {

@@ -182,7 +182,7 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     let map = match extracted_patches(&clouds, kind)? {
                         Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
                         None => AnyMap::PointCloud(PointCloudMap::from_points(&pc_points(
-                            &clouds, None,
+                            &clouds, None, None,
                         )?)?),
                     };
                     let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
@@ -207,7 +207,7 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                 if args.maps.contains(&MapKind::Pc) {
                     // The pc map after the mixed-pixel filter, for its cost and benefit.
                     let started = Instant::now();
-                    let points = pc_points(&clouds, Some(&MixedPixelConfig::alrf()))?;
+                    let points = pc_points(&clouds, Some(&MixedPixelConfig::alrf()), None)?;
                     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
                     let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
                     rows.push(safety_row(
