@@ -109,6 +109,19 @@ pub fn denoise_along_beams(
     cloud: &PointCloud,
     config: &BeamDenoiseConfig,
 ) -> Result<(PointCloud, usize), DenoiseError> {
+    denoise_along_beams_where(cloud, config, |_| true)
+}
+
+/// [`denoise_along_beams`] for the points `i` with `only(i)`; the others stay as they are but
+/// still serve as neighbours (e.g. a segmentation's remainder, before it is meshed).
+///
+/// # Errors
+/// As [`denoise_along_beams`].
+pub fn denoise_along_beams_where(
+    cloud: &PointCloud,
+    config: &BeamDenoiseConfig,
+    only: impl Fn(usize) -> bool,
+) -> Result<(PointCloud, usize), DenoiseError> {
     config.validate()?;
     let grid = cloud.grid().ok_or(DenoiseError::NoGrid)?;
     let points = cloud.positions();
@@ -116,7 +129,7 @@ pub fn denoise_along_beams(
     let mut out = points.to_vec();
     let mut moved = 0;
     for (pixel, &index) in grid.pixels().iter().enumerate() {
-        if index == INVALID_PIXEL {
+        if index == INVALID_PIXEL || !only(index as usize) {
             continue;
         }
         let p = points[index as usize];
@@ -167,19 +180,7 @@ pub fn denoise_along_beams(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use patch_core::Vector3;
-
-    /// A `w × h` scan of beams 0.5° apart around +x with ranges from `range(col, row)`.
-    fn scan(w: u32, h: u32, range: impl Fn(u32, u32) -> Option<Real>) -> PointCloud {
-        let step = 0.5f64.to_radians();
-        let pixels = (0..h).flat_map(|row| (0..w).map(move |col| (col, row))).map(|(col, row)| {
-            let yaw = (col as Real - w as Real / 2.0) * step;
-            let pitch = (row as Real - h as Real / 2.0) * step;
-            let dir = Vector3::new(yaw.cos() * pitch.cos(), yaw.sin() * pitch.cos(), pitch.sin());
-            range(col, row).map(|r| Point3::from(dir * r))
-        });
-        PointCloud::from_pixels(w, h, pixels.collect::<Vec<_>>()).unwrap()
-    }
+    use crate::mixed_pixels::tests::scan;
 
     /// A deterministic ±1 pattern.
     fn noise(col: u32, row: u32) -> Real {

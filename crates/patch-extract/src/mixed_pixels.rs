@@ -463,13 +463,13 @@ pub fn remove_mixed_pixels(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use patch_core::Vector3;
 
     /// An organised cloud of `w × h` beams 0.5° apart around +x, with the range of each pixel
     /// from `range(col, row)` (`None`: no measurement).
-    fn scan(w: u32, h: u32, range: impl Fn(u32, u32) -> Option<Real>) -> PointCloud {
+    pub(crate) fn scan(w: u32, h: u32, range: impl Fn(u32, u32) -> Option<Real>) -> PointCloud {
         let step = 0.5f64.to_radians();
         let pixels = (0..h).flat_map(|row| (0..w).map(move |col| (col, row))).map(|(col, row)| {
             let yaw = (col as Real - w as Real / 2.0) * step;

@@ -18,7 +18,7 @@
 //! should first drop the ±90° columns ([`crate::projection::invalidate_alrf_side_columns`],
 //! thesis App. A), which needs the scan's beam model and so is the caller's step.
 
-use crate::denoise::{BeamDenoiseConfig, DenoiseError, denoise_along_beams};
+use crate::denoise::{BeamDenoiseConfig, DenoiseError, denoise_along_beams_where};
 use crate::grid_mesh::RegionMask;
 use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
@@ -331,7 +331,11 @@ pub fn extract(
                     let denoised;
                     let scan = match &config.denoise {
                         Some(d) => {
-                            denoised = denoise_along_beams(scan, d)
+                            let mut in_remainder = vec![false; scan.len()];
+                            for &i in &segmentation.remainder {
+                                in_remainder[i as usize] = true;
+                            }
+                            denoised = denoise_along_beams_where(scan, d, |i| in_remainder[i])
                                 .map_err(|source| ExtractError::Denoise { scan: index, source })?
                                 .0;
                             &denoised

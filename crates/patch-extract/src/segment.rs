@@ -286,6 +286,12 @@ pub enum SegmentError {
 }
 
 impl SegmentConfig {
+    /// The jump test's longest link between points whose larger range is `range`, its range
+    /// part multiplied by `stretch` (1: the plain test; [`GrazingPlanes::link_cos`]).
+    pub fn jump_limit(&self, range: Real, stretch: Real) -> Real {
+        self.jump_absolute + self.jump_relative * stretch * range
+    }
+
     /// The thesis's actuated LRF (SICK S300, §2.1; scene-sim's model has σ = 3 cm):
     /// σ(r) = 3 cm + 0.1 mm/m² r², points within 2σ, MSE within (1.2σ)², 5×5 seeds widened
     /// to span at least 3σ ([`ALRF_SEED_MIN_EXTENT`]), jumps up
@@ -773,9 +779,7 @@ fn link_runs(grid: &Grid, points: &[Point3], config: &SegmentConfig) -> (Vec<u32
     let linked = |a: usize, b: usize| match (grid.pixels()[a], grid.pixels()[b]) {
         (pa, pb) if pa != INVALID_PIXEL && pb != INVALID_PIXEL => {
             let (p, q) = (points[pa as usize], points[pb as usize]);
-            let limit =
-                config.jump_absolute + config.jump_relative * p.coords.norm().max(q.coords.norm());
-            (p - q).norm() <= limit
+            (p - q).norm() <= config.jump_limit(p.coords.norm().max(q.coords.norm()), 1.0)
         }
         _ => false,
     };
@@ -812,8 +816,7 @@ struct Tests<'a> {
 
 impl Tests<'_> {
     fn linked(&self, a: usize, b: usize, steps: u32) -> bool {
-        let limit = self.config.jump_absolute
-            + self.config.jump_relative * self.range[a].max(self.range[b]);
+        let limit = self.config.jump_limit(self.range[a].max(self.range[b]), 1.0);
         (self.points[a] - self.points[b]).norm() <= limit * steps as Real
     }
 
@@ -843,8 +846,7 @@ impl Tests<'_> {
 
     /// The jump test with its range part multiplied by `stretch`.
     fn linked_by(&self, a: usize, b: usize, stretch: Real) -> bool {
-        let limit = self.config.jump_absolute
-            + self.config.jump_relative * stretch * self.range[a].max(self.range[b]);
+        let limit = self.config.jump_limit(self.range[a].max(self.range[b]), stretch);
         (self.points[a] - self.points[b]).norm() <= limit
     }
 
