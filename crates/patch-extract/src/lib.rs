@@ -56,7 +56,10 @@ pub mod spherical_grid;
 pub mod trimesh_grow;
 
 pub use merge::{MergeConfig, merge_coplanar};
-pub use mixed_pixels::{MixedPixelConfig, mixed_pixels, remove_mixed_pixels};
+pub use mixed_pixels::{
+    MixedPixelConfig, MixedPixelFix, fix_mixed_pixels, mixed_pixels, remove_mixed_pixels,
+    snap_mixed_pixels,
+};
 pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};

@@ -17,14 +17,14 @@
 use crate::input::InputArgs;
 use crate::progress::Progress;
 use crate::scene_map::{
-    MapKind, MapSource, ScanSetup, SceneSurfaces, Tessellation, extracted_patches_with, pc_points,
-    scan_clouds,
+    MapKind, MapSource, PcCleaning, ScanSetup, SceneSurfaces, Tessellation, extracted_patches_with,
+    pc_points, scan_clouds,
 };
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand, ValueEnum};
 use patch_core::{FromPatches, Patch, PatchId, Point3};
 use patch_extract::denoise::BeamDenoiseConfig;
-use patch_extract::{MixedPixelConfig, PipelineConfig, TrimeshGrowConfig};
+use patch_extract::{MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
 use patch_map::{
     AnyMap, Attribution, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap,
@@ -109,11 +109,20 @@ pub struct BuildArgs {
     /// noise-free, without mixed pixels).
     #[arg(long, default_value_t = 1.0)]
     pub scan_noise: f64,
-    /// With --scene: remove mixed pixels (points on depth discontinuities) from every scan
-    /// before extraction and from the pc map (off by default: it also removes points of thin
-    /// obstacles; see docs/map-safety.md).
+    /// With --scene: find mixed pixels (points on depth discontinuities) in every scan; they
+    /// are removed before extraction, and removed or snapped in the pc map
+    /// (--mixed-pixel-fix). Off by default: the filter also removes points that kept maps
+    /// safe (see docs/map-safety.md).
     #[arg(long)]
     pub mixed_pixels: bool,
+    /// With --mixed-pixels --kind pc: `snap` moves each mixed pixel along its beam onto its
+    /// foreground (the safer choice), `remove` drops it.
+    #[arg(long, default_value = "snap", requires = "mixed_pixels")]
+    pub mixed_pixel_fix: MixedPixelFix,
+    /// With --mixed-pixels: keep points without a farther neighbour across a veil edge (the
+    /// background guard: a wall seen between an occluder's parts).
+    #[arg(long, requires = "mixed_pixels")]
+    pub keep_background: bool,
     /// With --mixed-pixels: a line to a grid neighbour within this angle of the beam is a
     /// veil edge, degrees.
     #[arg(long, default_value_t = 30.0, requires = "mixed_pixels")]
@@ -295,6 +304,7 @@ fn scene_source(
             min_jump: args.min_jump,
             plane_tolerance: (args.plane_tolerance > 0.0).then_some(args.plane_tolerance),
             keep_foreground: true,
+            keep_background: args.keep_background,
         })
         .map(|f| f.validate().map(|()| f))
         .transpose()
@@ -323,11 +333,11 @@ fn scene_source(
             Source::Patches(patches)
         }
         None => {
-            let points = pc_points(
-                &scan_clouds(&scene, &setup)?,
-                filter.as_ref(),
-                args.denoise.then(BeamDenoiseConfig::alrf).as_ref(),
-            )?;
+            let cleaning = PcCleaning {
+                mixed_pixels: filter.map(|f| (f, args.mixed_pixel_fix)),
+                denoise: args.denoise.then(BeamDenoiseConfig::alrf),
+            };
+            let points = pc_points(&scan_clouds(&scene, &setup)?, &cleaning)?;
             progress.say(format!(
                 "scene `{name}`, pc map: {} ALRF scans, {} points",
                 args.scans,
@@ -679,8 +689,10 @@ mod tests {
         let s = StepSampling { samples: 20_000, seed: 5, ..StepSampling::in_box(truth.bounds()) };
         let rate = |map: &AnyMap| compare_maps(&truth, map, &s, Attribution::None).unwrap();
         let pc = AnyMap::PointCloud(
-            PointCloudMap::from_points(&crate::scene_map::pc_points(&clouds, None, None).unwrap())
-                .unwrap(),
+            PointCloudMap::from_points(
+                &crate::scene_map::pc_points(&clouds, &Default::default()).unwrap(),
+            )
+            .unwrap(),
         );
         let floor = rate(&pc).unsafe_rate().value;
         let mut seen = Vec::new();

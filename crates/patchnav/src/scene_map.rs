@@ -25,8 +25,8 @@ use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Rea
 use patch_extract::denoise::{BeamDenoiseConfig, denoise_along_beams};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
 use patch_extract::{
-    MixedPixelConfig, PipelineConfig, TrimeshGrowConfig, extract, grow_trimeshes,
-    remove_mixed_pixels,
+    MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig, extract, fix_mixed_pixels,
+    grow_trimeshes,
 };
 use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
@@ -273,7 +273,7 @@ pub fn build_map(
         MapSource::Scans => extracted_patches(&clouds, kind)?,
     };
     let Some(patches) = patches else {
-        let points = pc_points(&clouds, None, None)?;
+        let points = pc_points(&clouds, &PcCleaning::default())?;
         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
         return Ok(BuiltMap {
             kind,
@@ -320,30 +320,35 @@ pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
     })
 }
 
-/// The points of a pc map made from `clouds` (sensor frame with poses): each organised cloud
-/// without its mixed pixels when `filter` is given (the filter costs safety: see
-/// `patchnav experiment map-safety`), then denoised along its beams when `denoise` is given,
-/// moved to the world frame.
+/// How a pc map is made from organised scans. `Default`: nothing, the raw points (the
+/// occlusion floor of `patchnav map compare`).
+#[derive(Clone, Debug, Default)]
+pub struct PcCleaning {
+    /// Find mixed pixels with this configuration, then remove or snap them.
+    pub mixed_pixels: Option<(MixedPixelConfig, MixedPixelFix)>,
+    /// Then move locally planar points along their beams onto their neighbourhood's plane.
+    pub denoise: Option<BeamDenoiseConfig>,
+}
+
+/// The points of a pc map made from `clouds` (sensor frame with poses), each organised cloud
+/// cleaned as `cleaning` says, moved to the world frame. Unorganised clouds are taken as they
+/// are.
 ///
 /// # Errors
 /// The filter or the denoising refusing its parameters.
-pub fn pc_points(
-    clouds: &[PointCloud],
-    filter: Option<&MixedPixelConfig>,
-    denoise: Option<&BeamDenoiseConfig>,
-) -> Result<Vec<Point3>> {
+pub fn pc_points(clouds: &[PointCloud], cleaning: &PcCleaning) -> Result<Vec<Point3>> {
     let mut out = Vec::new();
     for cloud in clouds {
         if cloud.grid().is_none() {
             out.extend_from_slice(cloud.to_world().positions());
             continue;
         }
-        let filtered = match filter {
-            Some(f) => Some(remove_mixed_pixels(cloud, f)?.0),
+        let filtered = match &cleaning.mixed_pixels {
+            Some((config, fix)) => Some(fix_mixed_pixels(cloud, config, *fix)?.0),
             None => None,
         };
         let cloud = filtered.as_ref().unwrap_or(cloud);
-        match denoise {
+        match &cleaning.denoise {
             Some(d) => {
                 out.extend_from_slice(denoise_along_beams(cloud, d)?.0.to_world().positions())
             }
@@ -360,6 +365,29 @@ pub fn pc_points(
 /// # Errors
 /// A bad angular step, or fewer poses than asked for.
 pub fn scan_clouds(scene: &Scene, setup: &ScanSetup) -> Result<Vec<PointCloud>> {
+    simulated_scans(scene, setup, None)
+}
+
+/// [`scan_clouds`] without the phantoms: the pixels the simulator blended across a depth edge
+/// (its mixed pixels) whose range is more than `tolerance` metres off their own surface's. The
+/// pc map a perfect mixed-pixel filter would give: a reference for the real one
+/// (`patchnav experiment map-safety`), not a pipeline input.
+///
+/// # Errors
+/// As [`scan_clouds`].
+pub fn scan_clouds_without_phantoms(
+    scene: &Scene,
+    setup: &ScanSetup,
+    tolerance: Real,
+) -> Result<Vec<PointCloud>> {
+    simulated_scans(scene, setup, Some(tolerance))
+}
+
+fn simulated_scans(
+    scene: &Scene,
+    setup: &ScanSetup,
+    phantom_tolerance: Option<Real>,
+) -> Result<Vec<PointCloud>> {
     let mut config = match setup.step_deg {
         None => AlrfConfig::sick_s300(),
         Some(step) => AlrfConfig::sick_s300_with_step(step.to_radians())
@@ -388,7 +416,20 @@ pub fn scan_clouds(scene: &Scene, setup: &ScanSetup) -> Result<Vec<PointCloud>> 
         .map(|(i, body)| {
             let seed = scene_sim::sensors::derive_seed(setup.seed, i as u64);
             let scan = alrf.scan(scene, &alrf.mount(body), seed);
-            let cloud = scan.to_cloud().context("building a scan's cloud")?;
+            let mut cloud = scan.to_cloud().context("building a scan's cloud")?;
+            if let (Some(tol), Some(grid)) = (phantom_tolerance, cloud.grid()) {
+                let ranges = scan.image.ranges();
+                let mut phantom = vec![false; cloud.len()];
+                for (k, &i) in grid.pixels().iter().enumerate() {
+                    if i != pointcloud::INVALID_PIXEL
+                        && scan.truth.mixed_pixel[k]
+                        && let (Some(r), Some(t)) = (ranges[k], scan.truth.true_range[k])
+                    {
+                        phantom[i as usize] = (Real::from(r) - Real::from(t)).abs() > tol;
+                    }
+                }
+                cloud = cloud.retain_indices(|i| !phantom[i]);
+            }
             Ok(match scan.image.beams() {
                 BeamModel::ActuatedLrf(model) => {
                     invalidate_alrf_side_columns(&cloud, model, &AlrfSideColumns::thesis())?.0

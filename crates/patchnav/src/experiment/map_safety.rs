@@ -17,18 +17,23 @@
 use super::extraction::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
-    MapKind, PatchBackend, ScanSetup, extracted_patches, patch_map, pc_points, scan_clouds,
-    truth_patches,
+    MapKind, PatchBackend, PcCleaning, ScanSetup, extracted_patches, patch_map, pc_points,
+    scan_clouds, scan_clouds_without_phantoms, truth_patches,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
-use patch_extract::MixedPixelConfig;
+use patch_extract::denoise::BeamDenoiseConfig;
+use patch_extract::{MixedPixelConfig, MixedPixelFix};
 use patch_map::{AnyMap, Attribution, MapComparison, PointCloudMap, StepSampling, compare_maps};
 use roadmap::{Goal, MaxIterations, PlannerKind, PlanningSpace, Problem, named_planner_on};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::time::Instant;
+
+/// A mixed pixel more than this many metres off its own surface is a phantom in the
+/// `pc-no-phantoms` row (3σ of the S300 model).
+const PHANTOM_TOLERANCE: Real = 0.09;
 
 /// Arguments of `patchnav experiment map-safety`.
 #[derive(Args, Debug, Clone)]
@@ -182,7 +187,8 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     let map = match extracted_patches(&clouds, kind)? {
                         Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
                         None => AnyMap::PointCloud(PointCloudMap::from_points(&pc_points(
-                            &clouds, None, None,
+                            &clouds,
+                            &PcCleaning::default(),
                         )?)?),
                     };
                     let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
@@ -205,18 +211,43 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     rows.push(row);
                 }
                 if args.maps.contains(&MapKind::Pc) {
-                    // The pc map after the mixed-pixel filter, for its cost and benefit.
-                    let started = Instant::now();
-                    let points = pc_points(&clouds, Some(&MixedPixelConfig::alrf()), None)?;
+                    // The pc map cleaned in three ways, and the one a perfect mixed-pixel
+                    // filter would give (the simulator's phantoms dropped).
+                    let filter = MixedPixelConfig::alrf();
+                    let cleanings = [
+                        ("pc-removed", Some((filter, MixedPixelFix::Remove)), None),
+                        ("pc-snapped", Some((filter, MixedPixelFix::SnapToForeground)), None),
+                        (
+                            "pc-snapped-denoised",
+                            Some((filter, MixedPixelFix::SnapToForeground)),
+                            Some(BeamDenoiseConfig::alrf()),
+                        ),
+                    ];
+                    for (label, mixed_pixels, denoise) in cleanings {
+                        let started = Instant::now();
+                        let points = pc_points(&clouds, &PcCleaning { mixed_pixels, denoise })?;
+                        let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
+                        let seconds_per_scan =
+                            started.elapsed().as_secs_f64() / scans.max(1) as Real;
+                        rows.push(safety_row(
+                            (name, noise, scans),
+                            label,
+                            &truth,
+                            &map,
+                            &sampling,
+                            seconds_per_scan,
+                        )?);
+                    }
+                    let clean = scan_clouds_without_phantoms(&scene, &setup, PHANTOM_TOLERANCE)?;
+                    let points = pc_points(&clean, &PcCleaning::default())?;
                     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-                    let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
                     rows.push(safety_row(
                         (name, noise, scans),
-                        "pc-filtered",
+                        "pc-no-phantoms",
                         &truth,
                         &map,
                         &sampling,
-                        seconds_per_scan,
+                        0.0,
                     )?);
                 }
                 spinner.finish_and_clear();

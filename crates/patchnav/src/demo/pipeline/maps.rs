@@ -255,7 +255,7 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
         )?;
     }
     let t0 = Instant::now();
-    let points: Vec<Point3> = crate::scene_map::pc_points(&lab.clouds, None, None)?;
+    let points: Vec<Point3> = crate::scene_map::pc_points(&lab.clouds, &Default::default())?;
     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
     let build_seconds = t0.elapsed().as_secs_f64();
     let (row, drawing) = point_map_entry(&map, &points, build_seconds)?;
