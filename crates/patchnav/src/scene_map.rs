@@ -249,10 +249,12 @@ impl BuiltMap {
     }
 }
 
-/// Builds the map of `kind` for `scene`: patch maps in `backend`, the `pc` map from `scans`.
+/// Builds the map of `kind` for `scene`: patch maps in `backend`, the `pc` map from `scans`
+/// cleaned as `pc` says.
 ///
 /// # Errors
 /// As [`SceneSurfaces::of`], a backend refusing the patches or points, or no scan pose found.
+#[allow(clippy::too_many_arguments)]
 pub fn build_map(
     scene: &Scene,
     surfaces: &SceneSurfaces,
@@ -261,6 +263,7 @@ pub fn build_map(
     t: &Tessellation,
     scans: &ScanSetup,
     source: MapSource,
+    pc: &PcCleaning,
 ) -> Result<BuiltMap> {
     // Scanned once, for extraction and for the pc map alike.
     let clouds = if source == MapSource::Scans || kind == MapKind::Pc {
@@ -273,7 +276,7 @@ pub fn build_map(
         MapSource::Scans => extracted_patches(&clouds, kind)?,
     };
     let Some(patches) = patches else {
-        let points = pc_points(&clouds, &PcCleaning::default())?;
+        let points = pc_points(&clouds, pc)?;
         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
         return Ok(BuiltMap {
             kind,

@@ -47,11 +47,14 @@
 
 use crate::progress::Progress;
 use crate::scene_map::{
-    BuiltMap, MapKind, MapSource, PatchBackend, ScanSetup, SceneSurfaces, Tessellation, build_map,
+    BuiltMap, MapKind, MapSource, PatchBackend, PcCleaning, ScanSetup, SceneSurfaces, Tessellation,
+    build_map,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
+use patch_extract::denoise::BeamDenoiseConfig;
+use patch_extract::{MixedPixelConfig, MixedPixelFix};
 use patch_map::AnyMap;
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
@@ -111,6 +114,13 @@ pub struct LabMapArgs {
     /// Iterations of every run (K).
     #[arg(long, default_value_t = 1000)]
     pub max_iterations: u64,
+    /// Clean the pc map's scans of mixed pixels first (`snap` onto their foreground, or
+    /// `remove`); without it the pc map is the raw scans, as the thesis's.
+    #[arg(long)]
+    pub pc_mixed_pixels: Option<MixedPixelFix>,
+    /// Denoise the pc map's scans along their beams (after --pc-mixed-pixels).
+    #[arg(long)]
+    pub pc_denoise: bool,
     /// Sample every map in the box common to all maps (their intersection) instead of each
     /// map's own box (the thesis's choice, L6460; the pc map's box is larger by the sensor
     /// noise).
@@ -210,7 +220,11 @@ fn build_lab(args: &LabMapArgs, progress: &Progress) -> Result<Lab> {
     for kind in kinds {
         let spinner = progress.spinner(&format!("building the {kind} map"));
         let t0 = Instant::now();
-        let map = build_map(&scene, &surfaces, kind, args.backend, &t, &scans, args.source)
+        let pc = PcCleaning {
+            mixed_pixels: args.pc_mixed_pixels.map(|fix| (MixedPixelConfig::alrf(), fix)),
+            denoise: args.pc_denoise.then(BeamDenoiseConfig::alrf),
+        };
+        let map = build_map(&scene, &surfaces, kind, args.backend, &t, &scans, args.source, &pc)
             .with_context(|| format!("building the {kind} map"))?;
         build_seconds.push(t0.elapsed().as_secs_f64());
         spinner.finish_and_clear();

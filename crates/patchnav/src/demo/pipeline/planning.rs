@@ -70,6 +70,8 @@ fn corner_args() -> LabMapArgs {
         step: STEP,
         starts: 4,
         max_iterations: 0,
+        pc_mixed_pixels: None,
+        pc_denoise: false,
         common_box: false,
     }
 }
