@@ -27,7 +27,10 @@
 //! union–find over edge-adjacent triangles counts components and a per-vertex flag counts
 //! covered points; the first candidate meeting both conditions is returned, widened by a
 //! relative `1e-9` so that cocircular points (regular grids), whose radii differ only by
-//! rounding, count as ties. This is
+//! rounding, count as ties. Coverage only grows with α, so no candidate below the smallest
+//! radius at which enough points are covered (each point is covered from the smallest
+//! circumradius of its triangles on: a selection, O(n)) can qualify: the triangles up to it
+//! enter at once, and only the larger ones are sorted. This is
 //! O(n log n) and exact; CGAL bisects over the candidates instead, which can return a larger α
 //! where the component count is not monotone in α. The whole triangulation is always one
 //! component covering every point, so a candidate always exists.
@@ -283,26 +286,55 @@ fn build_mesh(points: &[Point2]) -> Result<Mesh, AlphaShapeError> {
         lo = lo.inf(p);
         hi = hi.sup(p);
     }
-    let total_area: Real = dt.inner_faces().map(|f| f.area()).sum();
-    if total_area <= 1e-10 * (hi - lo).norm_squared() {
-        return Err(AlphaShapeError::Collinear);
-    }
     let n = dt.num_inner_faces();
     let mut triangles = vec![[0; 3]; n];
     let mut neighbours = vec![[NONE; 3]; n];
-    let mut radius2 = vec![0.0; n];
-    for face in dt.inner_faces() {
-        // Inner faces are numbered from 1 (0 is the outer face).
+    // A face's corners in the order of its `adjacent_edges()` `[e0, e1, e2]` (`e1` its
+    // `adjacent_edge()`, `e0` before it, `e2` after it) with the face across each edge, filled
+    // edge by edge in storage order (fewer cache misses than walking each face's edges).
+    // Inner faces are numbered from 1 (0 is the outer face).
+    let adjacent: Vec<usize> = dt.inner_faces().map(|f| f.adjacent_edge().fix().index()).collect();
+    for e in dt.directed_edges() {
+        let Some(face) = e.face().as_inner() else { continue };
         let t = face.fix().index() - 1;
-        let edges = face.adjacent_edges();
-        for (i, e) in edges.iter().enumerate() {
-            triangles[t][i] = e.from().fix().index() as u32;
-            neighbours[t][i] =
-                e.rev().face().as_inner().map_or(NONE, |f| (f.fix().index() - 1) as u32);
-        }
-        let r2 = face.circumcircle().1;
-        radius2[t] = if r2.is_nan() { Real::INFINITY } else { r2 };
+        let first = adjacent[t];
+        let i = if e.fix().index() == first {
+            1
+        } else if e.next().fix().index() == first {
+            0
+        } else {
+            2
+        };
+        triangles[t][i] = e.from().fix().index() as u32;
+        neighbours[t][i] = e.rev().face().as_inner().map_or(NONE, |f| (f.fix().index() - 1) as u32);
     }
+    // Areas and circumradii as spade's `area` and `circumcircle` compute them from the
+    // face's vertex positions (in this order), summed in face order.
+    let corners = |t: usize| {
+        let [a, b, c] = triangles[t].map(|v| vertices[v as usize]);
+        (a, b - a, c - a)
+    };
+    let total_area: Real = (0..n)
+        .map(|t| {
+            let (_, b, c) = corners(t);
+            (b.x * c.y - b.y * c.x).abs() * 0.5
+        })
+        .sum();
+    if total_area <= 1e-10 * (hi - lo).norm_squared() {
+        return Err(AlphaShapeError::Collinear);
+    }
+    let radius2 = (0..n)
+        .map(|t| {
+            let (_, b, c) = corners(t);
+            let d = 2.0 * (b.x * c.y - c.x * b.y);
+            let (len_b, len_c) = (b.x * b.x + b.y * b.y, c.x * c.x + c.y * c.y);
+            let d_inv = 1.0 / d;
+            let x = (len_b * c.y - len_c * b.y) * d_inv;
+            let y = (-len_b * c.x + len_c * b.x) * d_inv;
+            let r2 = x * x + y * y;
+            if r2.is_nan() { Real::INFINITY } else { r2 }
+        })
+        .collect();
     Ok(Mesh { vertices, triangles, neighbours, radius2 })
 }
 
@@ -333,46 +365,102 @@ impl UnionFind {
     }
 }
 
+/// An integer whose order is [`f64::total_cmp`]'s order of `x` (the key `total_cmp` itself
+/// compares).
+fn total_order_key(x: Real) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ ((((bits >> 63) as u64) >> 1) as i64)
+}
+
 /// The optimal squared radius with at most `allowed_uncovered` points uncovered: see the
 /// module docs.
-fn optimal_alpha_squared(mesh: &Mesh, max_components: usize, allowed_uncovered: usize) -> Real {
+/// With the squared radius: the union–find over the triangles added by then (those with a
+/// squared radius up to the candidate's, `added`), whose classes are their components.
+fn optimal_alpha_squared(
+    mesh: &Mesh,
+    max_components: usize,
+    allowed_uncovered: usize,
+) -> (Real, UnionFind, Vec<bool>) {
     let n = mesh.triangles.len();
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    order.sort_unstable_by(|&a, &b| mesh.radius2[a as usize].total_cmp(&mesh.radius2[b as usize]));
+    let nv = mesh.vertices.len();
     let mut uf = UnionFind::new(n);
     let mut added = vec![false; n];
-    let mut covered = vec![false; mesh.vertices.len()];
-    let mut uncovered = mesh.vertices.len();
+    let mut covered = vec![false; nv];
+    let mut uncovered = nv;
     let mut components = 0usize;
+    let mut add = |t: u32, uncovered: &mut usize, components: &mut usize| {
+        added[t as usize] = true;
+        *components += 1;
+        for i in 0..3 {
+            let v = mesh.triangles[t as usize][i] as usize;
+            if !covered[v] {
+                covered[v] = true;
+                *uncovered -= 1;
+            }
+            let m = mesh.neighbours[t as usize][i];
+            if m != NONE && added[m as usize] && uf.union(t, m) {
+                *components -= 1;
+            }
+        }
+    };
+    // No candidate below the smallest squared radius `first` at which few enough points are
+    // uncovered can be accepted (coverage only grows with α); a vertex is covered from the
+    // smallest radius of its triangles on. The triangles up to `first` enter at once, in index
+    // order (the component count and the coverage do not depend on the order); only the
+    // larger ones are sorted. With every radius positive (no NaN, no zero) `==` ties and
+    // `total_cmp` order agree.
+    let (mut first, mut found) = (None, None);
+    if n > 0 && allowed_uncovered < nv && mesh.radius2.iter().all(|&r2| r2 > 0.0) {
+        let mut smallest = vec![Real::INFINITY; nv];
+        for (tri, &r2) in mesh.triangles.iter().zip(&mesh.radius2) {
+            for &v in tri {
+                smallest[v as usize] = smallest[v as usize].min(r2);
+            }
+        }
+        let k = nv - allowed_uncovered - 1;
+        let (_, &mut threshold, _) = smallest.select_nth_unstable_by(k, Real::total_cmp);
+        for t in 0..n {
+            if mesh.radius2[t] <= threshold {
+                add(t as u32, &mut uncovered, &mut components);
+            }
+        }
+        if uncovered <= allowed_uncovered && components <= max_components {
+            found = Some(threshold);
+        }
+        first = Some(threshold);
+    }
+    if let Some(r2) = found {
+        return (r2 * (1.0 + 1e-9), uf, added);
+    }
+    // The other triangles by squared radius (`total_cmp` order, on its integer image sorted
+    // with the index alongside); the order within ties does not matter, ties enter together.
+    let mut keyed: Vec<(i64, u32)> = mesh
+        .radius2
+        .iter()
+        .enumerate()
+        .filter(|&(_, &r2)| first.is_none_or(|f| r2 > f))
+        .map(|(t, &r2)| (total_order_key(r2), t as u32))
+        .collect();
+    keyed.sort_unstable_by_key(|&(key, _)| key);
+    let order: Vec<u32> = keyed.into_iter().map(|(_, t)| t).collect();
     let mut k = 0;
-    while k < n {
+    while k < order.len() {
         let r2 = mesh.radius2[order[k] as usize];
         // Add every triangle with this squared radius (ties enter together).
-        while k < n && mesh.radius2[order[k] as usize] == r2 {
-            let t = order[k];
-            added[t as usize] = true;
-            components += 1;
-            for i in 0..3 {
-                let v = mesh.triangles[t as usize][i] as usize;
-                if !covered[v] {
-                    covered[v] = true;
-                    uncovered -= 1;
-                }
-                let m = mesh.neighbours[t as usize][i];
-                if m != NONE && added[m as usize] && uf.union(t, m) {
-                    components -= 1;
-                }
-            }
+        while k < order.len() && mesh.radius2[order[k] as usize] == r2 {
+            add(order[k], &mut uncovered, &mut components);
             k += 1;
         }
         if uncovered <= allowed_uncovered && components <= max_components {
             // Cocircular points (regular grids) give radii equal up to rounding: count values
             // within a relative 1e-9 as ties.
-            return r2 * (1.0 + 1e-9);
+            return (r2 * (1.0 + 1e-9), uf, added);
         }
     }
-    // Unreachable for a valid triangulation (all triangles = one covering component).
-    mesh.radius2[order[n - 1] as usize]
+    // Unreachable for a valid triangulation (all triangles = one covering component): the
+    // largest squared radius.
+    let largest = mesh.radius2.iter().copied().max_by(Real::total_cmp).unwrap_or(Real::INFINITY);
+    (largest, uf, added)
 }
 
 /// CGAL's `find_optimal_alpha(max_components)` for these points, as a radius: see the module
@@ -388,7 +476,7 @@ pub fn optimal_alpha(points: &[Point2], max_components: usize) -> Result<Real, A
         return Err(AlphaShapeError::InvalidAlpha { value: 0.0 });
     }
     let mesh = build_mesh(points)?;
-    Ok(optimal_alpha_squared(&mesh, max_components, 0).sqrt())
+    Ok(optimal_alpha_squared(&mesh, max_components, 0).0.sqrt())
 }
 
 /// The regularized α-shape of `points` as polygons with holes (see the module docs).
@@ -424,12 +512,17 @@ pub fn alpha_shape(
         return Err(AlphaShapeError::InvalidAlpha { value: v });
     }
     let mesh = build_mesh(points)?;
-    let alpha_squared = match config.alpha {
-        AlphaChoice::Radius(a) => a * a,
-        AlphaChoice::Optimal { max_components } => optimal_alpha_squared(&mesh, max_components, 0),
+    // With the search's union–find: the components of the triangles it added.
+    let (alpha_squared, searched) = match config.alpha {
+        AlphaChoice::Radius(a) => (a * a, None),
+        AlphaChoice::Optimal { max_components } => {
+            let (alpha_squared, uf, added) = optimal_alpha_squared(&mesh, max_components, 0);
+            (alpha_squared, Some((uf, added)))
+        }
         AlphaChoice::Robust { max_components, max_uncovered } => {
             let allowed = (max_uncovered * mesh.vertices.len() as Real).floor() as usize;
-            optimal_alpha_squared(&mesh, max_components, allowed)
+            let (alpha_squared, uf, added) = optimal_alpha_squared(&mesh, max_components, allowed);
+            (alpha_squared, Some((uf, added)))
         }
     };
     let alpha = alpha_squared.sqrt();
@@ -452,14 +545,18 @@ pub fn alpha_shape(
         return Err(AlphaShapeError::Empty { alpha });
     }
     // Components.
+    // The classes do not depend on the order of the unions. The search added a subset of the
+    // interior triangles (radii up to the candidate's, below α² = candidate · (1 + 1e-9)) and
+    // joined every adjacent pair of them; the rest join their interior neighbours here.
     let n = mesh.triangles.len();
-    let mut uf = UnionFind::new(n);
+    let (mut uf, added) = searched.unwrap_or_else(|| (UnionFind::new(n), vec![false; n]));
     for t in 0..n {
-        if !interior[t] {
+        if !interior[t] || added[t] {
             continue;
         }
         for &m in &mesh.neighbours[t] {
-            if m != NONE && interior[m as usize] {
+            // A pair of two such triangles once, from its later one.
+            if m != NONE && interior[m as usize] && (added[m as usize] || (m as usize) < t) {
                 uf.union(t as u32, m);
             }
         }

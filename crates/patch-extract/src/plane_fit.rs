@@ -6,7 +6,9 @@
 //! (the first point added) so that points far from the origin do not cancel catastrophically
 //! when the scatter matrix `S = Σ x xᵀ − n c cᵀ` is formed. Adding or removing a point and
 //! merging two accumulators are O(1); [`PlaneAccumulator::fit`] solves the 3×3 symmetric
-//! eigenproblem of `S` on demand (nalgebra's `SymmetricEigen`):
+//! eigenproblem of `S` on demand (nalgebra's `SymmetricEigen` algorithm, its QR iteration
+//! written out for the fixed size with the same floating-point operations, so the results are
+//! bit for bit nalgebra's):
 //!
 //! * the centroid `c = Σ x / n`;
 //! * the normal `n̂` = the eigenvector of the smallest eigenvalue `λ₀` of `S`;
@@ -129,11 +131,32 @@ impl PlaneAccumulator {
 
     /// The sums of `points`.
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a Point3>) -> PlaneAccumulator {
-        let mut acc = PlaneAccumulator::new();
-        for p in points {
-            acc.add(p);
+        // `add` for each point, with the sums in locals: the same operations in the same order.
+        let mut points = points.into_iter();
+        let Some(first) = points.next() else { return PlaneAccumulator::new() };
+        let reference = first.coords;
+        let mut count = 0;
+        let (mut sx, mut sy, mut sz) = (0.0, 0.0, 0.0);
+        let (mut xx, mut xy, mut xz, mut yy, mut yz, mut zz) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for p in std::iter::once(first).chain(points) {
+            count += 1;
+            let (x, y, z) = (p.x - reference.x, p.y - reference.y, p.z - reference.z);
+            sx += x;
+            sy += y;
+            sz += z;
+            xx += x * x;
+            xy += x * y;
+            xz += x * z;
+            yy += y * y;
+            yz += y * z;
+            zz += z * z;
         }
-        acc
+        PlaneAccumulator {
+            count,
+            reference,
+            sum: Vector3::new(sx, sy, sz),
+            sum_sq: [xx, xy, xz, yy, yz, zz],
+        }
     }
 
     /// The number of points.
@@ -158,13 +181,22 @@ impl PlaneAccumulator {
     }
 
     /// Adds a point. O(1).
+    #[inline]
     pub fn add(&mut self, p: &Point3) {
         if self.count == 0 {
             *self = PlaneAccumulator { reference: p.coords, ..PlaneAccumulator::default() };
         }
         self.count += 1;
         let v = p.coords - self.reference;
-        self.accumulate(&v, 1.0);
+        // `accumulate(&v, 1.0)` without the multiplications by 1, which are exact.
+        self.sum += v;
+        let s = &mut self.sum_sq;
+        s[0] += v.x * v.x;
+        s[1] += v.x * v.y;
+        s[2] += v.x * v.z;
+        s[3] += v.y * v.y;
+        s[4] += v.y * v.z;
+        s[5] += v.z * v.z;
     }
 
     /// Removes a point that was added before (removing a point that is not in the set gives
@@ -237,7 +269,7 @@ impl PlaneAccumulator {
             return None;
         }
         let centroid = self.centroid()?;
-        let eig = SymmetricEigen::new(self.scatter()?);
+        let eig = symmetric_eigen(self.scatter()?);
         let mut order = [0usize, 1, 2];
         order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
         let eigenvalues = Vector3::new(
@@ -268,6 +300,270 @@ impl PlaneAccumulator {
             count: self.count,
         })
     }
+}
+
+/// A plane fit's normal and surface variation known to within certified bounds, from
+/// [`PlaneAccumulator::certified_plane`] (without the eigendecomposition of
+/// [`PlaneAccumulator::fit`]).
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(crate) struct CertifiedPlane {
+    /// At most [`PlaneFit::curvature`] of the fit, in [`f64::total_cmp`] order.
+    pub curvature_lower: Real,
+    /// A unit vector within `normal_error` (Euclidean distance) of the fit's normal or of
+    /// its opposite.
+    pub normal: Vector3,
+    /// See `normal`.
+    pub normal_error: Real,
+}
+
+impl PlaneAccumulator {
+    /// Bounds on what [`PlaneAccumulator::fit`] (with any viewpoint) gives, certified for
+    /// rounding: `None` when they cannot be certified cheaply (non-finite sums, nearly equal
+    /// smallest eigenvalues, fewer than three points), and then only [`fit`](Self::fit)
+    /// tells. When `Some`, the fit is `Some` too.
+    ///
+    /// The normal is the smallest eigenvector of the scatter matrix `S` by one step of power
+    /// iteration on its adjugate; with `λ'` its Rayleigh quotient and `r` its residual, the
+    /// second eigenvalue `λ₁` is at least the smaller eigenvalue `μ₁` of `S` compressed to the
+    /// normal's orthogonal complement (Cauchy interlacing), so the angle to the true normal is
+    /// at most `|r| / (μ₁ − λ')` (Davis–Kahan) and `λ₀ ≥ λ' − |r|² / (μ₁ − λ')` (Kato–Temple).
+    /// Slack far above rounding (relative `1e-10` of `|S|`) covers the floating-point
+    /// evaluation here and in `fit`'s eigensolver.
+    pub(crate) fn certified_plane(&self) -> Option<CertifiedPlane> {
+        if self.count < 3 {
+            return None;
+        }
+        certify(&self.scatter()?)
+    }
+}
+
+/// [`PlaneAccumulator::certified_plane`] of the points `members` of `points` (at least three,
+/// at most 49: the bounds allow for the summation order, which is not `from_points`'s).
+pub(crate) fn certified_window_plane(points: &[Point3], members: &[u32]) -> Option<CertifiedPlane> {
+    if !(3..=49).contains(&members.len()) {
+        return None;
+    }
+    let reference = points[members[0] as usize].coords;
+    // Two interleaved partial sums (independent dependency chains), relative to the first
+    // point: [x, y, z, xx, xy, xz, yy, yz, zz].
+    let terms = |p: u32| {
+        let v = points[p as usize].coords - reference;
+        [v.x, v.y, v.z, v.x * v.x, v.x * v.y, v.x * v.z, v.y * v.y, v.y * v.z, v.z * v.z]
+    };
+    let add =
+        |acc: [Real; 9], t: [Real; 9]| -> [Real; 9] { std::array::from_fn(|k| acc[k] + t[k]) };
+    let (mut even, mut odd) = ([0.0; 9], [0.0; 9]);
+    let mut pairs = members.chunks_exact(2);
+    for pair in &mut pairs {
+        even = add(even, terms(pair[0]));
+        odd = add(odd, terms(pair[1]));
+    }
+    if let [last] = pairs.remainder() {
+        even = add(even, terms(*last));
+    }
+    let t = add(even, odd);
+    let n = members.len() as Real;
+    let sum = Vector3::new(t[0], t[1], t[2]);
+    let m = sum / n;
+    let raw = Matrix3::new(t[3], t[4], t[5], t[4], t[6], t[7], t[5], t[7], t[8]);
+    certify(&(raw - m * sum.transpose()))
+}
+
+/// The bounds of [`PlaneAccumulator::certified_plane`] from a scatter matrix `m` (of at least
+/// three points; symmetric up to rounding).
+fn certify(m: &Matrix3<Real>) -> Option<CertifiedPlane> {
+    if !m.iter().all(|e| e.is_finite()) {
+        return None;
+    }
+    let sym = |i: usize, j: usize| 0.5 * (m[(i, j)] + m[(j, i)]);
+    let (a, b, c, d, e, f) = (sym(0, 0), sym(0, 1), sym(0, 2), sym(1, 1), sym(1, 2), sym(2, 2));
+    let s = Matrix3::new(a, b, c, b, d, e, c, e, f);
+    // A bound of the spectral norm (the sum of the entries' magnitudes, at least the
+    // Frobenius norm).
+    let norm: Real = m.iter().map(|x| x.abs()).sum();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return None;
+    }
+    let adj = Matrix3::new(
+        d * f - e * e,
+        c * e - b * f,
+        b * e - c * d,
+        c * e - b * f,
+        a * f - c * c,
+        b * c - a * e,
+        b * e - c * d,
+        b * c - a * e,
+        a * d - b * b,
+    );
+    let column = (0..3)
+        .max_by(|&i, &j| adj.column(i).norm_squared().total_cmp(&adj.column(j).norm_squared()))?;
+    // The adjugate's largest column and its image, normalised once (scale aside, both are
+    // the same direction; entries are of the order |S|⁴ at most, far from overflow for any
+    // plausible window, and a non-finite or zero length gives no bound).
+    let v = adj * adj.column(column);
+    let length = v.norm();
+    if !(length > 0.0 && length.is_finite()) {
+        return None;
+    }
+    let v = v * (1.0 / length);
+    let rayleigh = v.dot(&(s * v));
+    let residual = (s * v - v * rayleigh).norm();
+    // The compression of S to v's orthogonal complement: trace and determinant.
+    let t = (a + d + f) - rayleigh;
+    let q = v.dot(&(adj * v));
+    let mu2 = 0.5 * (t + (t * t - 4.0 * q).max(0.0).sqrt());
+    if mu2.is_nan() || mu2 <= 0.0 {
+        return None;
+    }
+    // Reciprocals instead of divisions: their extra ulp is far inside the slack.
+    let inverse_mu2 = 1.0 / mu2;
+    let mu1 = q * inverse_mu2;
+    let slack = 1e-10 * norm;
+    let mu1_lower = mu1 - slack - 1e-10 * norm * norm * inverse_mu2;
+    let gap = mu1_lower - rayleigh - slack;
+    if !(gap > 1e-6 * norm && mu1_lower > 1e-9 * norm) {
+        return None;
+    }
+    let inverse_gap = 1.0 / gap;
+    let angle = (residual + slack) * inverse_gap + 1e-9;
+    if angle.is_nan() || angle >= 0.5 {
+        return None;
+    }
+    let lambda0_lower = (rayleigh - residual * residual * inverse_gap - slack).max(0.0);
+    let total_upper = (a + d + f) + 3.0 * slack;
+    let lower = lambda0_lower / total_upper * (1.0 - 1e-9);
+    let curvature_lower = if lower > 0.0 && lower.is_finite() { lower } else { -0.0 };
+    // sin θ ≤ `angle` < 1/2, so the chord 2 sin(θ/2) is below 1.04 `angle`.
+    Some(CertifiedPlane { curvature_lower, normal: v, normal_error: 1.05 * angle })
+}
+
+/// `nalgebra::SymmetricEigen::new(m)` for a 3×3 matrix, bit for bit: the same operations in
+/// the same order (scaling by the largest entry, Householder tridiagonalisation by nalgebra
+/// itself, then the implicit symmetric QR iteration with Wilkinson shifts and Givens
+/// rotations, and the closed-form 2×2 step), written out for fixed sizes, which the generic
+/// code is not. A matrix with a non-finite entry goes to nalgebra.
+fn symmetric_eigen(mut m: Matrix3<Real>) -> SymmetricEigen<Real, nalgebra::U3> {
+    if !m.iter().all(|e| e.is_finite()) {
+        return SymmetricEigen::new(m);
+    }
+    let eps = Real::EPSILON;
+    let m_amax = m.iter().fold(0.0, |a: Real, e| a.max(e.abs()));
+    if m_amax != 0.0 {
+        m.iter_mut().for_each(|e| *e /= m_amax);
+    }
+    let (mut q, diag, off) = nalgebra::linalg::SymmetricTridiagonal::new(m).unpack();
+    let mut d = [diag[0], diag[1], diag[2]];
+    let mut o = [off[0], off[1]];
+    // Rotates columns `i` and `i + 1` of `q` by (c, s) as `GivensRotation::rotate_rows`.
+    let rotate = |q: &mut Matrix3<Real>, i: usize, c: Real, s: Real| {
+        for j in 0..3 {
+            let (a, b) = (q[(j, i)], q[(j, i + 1)]);
+            q[(j, i)] = a * c + s * b;
+            q[(j, i + 1)] = -s * a + b * c;
+        }
+    };
+    let (mut start, mut end) = delimit_subproblem(&d, &mut o, 2, eps);
+    while end != start {
+        let subdim = end - start + 1;
+        if subdim > 2 {
+            let (mm, n) = (end - 1, end);
+            let (mut vx, mut vy) = (d[start] - wilkinson_shift(d[mm], d[n], o[mm]), o[start]);
+            for i in start..n {
+                let j = i + 1;
+                // `GivensRotation::cancel_y`.
+                if vy == 0.0 {
+                    break;
+                }
+                let (mod0, sign0) = if vx >= 0.0 { (vx, 1.0) } else { (-vx, -1.0) };
+                let denom = (mod0 * mod0 + vy * vy).sqrt();
+                let c = mod0 / denom;
+                let s = -vy / (sign0 * denom);
+                let norm = sign0 * denom;
+                if i > start {
+                    o[i - 1] = norm;
+                }
+                let (mii, mjj, mij) = (d[i], d[j], o[i]);
+                let (cc, ss, cs) = (c * c, s * s, c * s);
+                let b = cs * 2.0 * mij;
+                d[i] = (cc * mii + ss * mjj) - b;
+                d[j] = (ss * mii + cc * mjj) + b;
+                o[i] = cs * (mii - mjj) + mij * (cc - ss);
+                if i != n - 1 {
+                    vx = o[i];
+                    vy = -s * o[i + 1];
+                    o[i + 1] *= c;
+                }
+                // The inverse rotation: sine −s.
+                rotate(&mut q, i, c, -s);
+            }
+            if o[mm].abs() <= eps * (d[mm].abs() + d[n].abs()) {
+                end -= 1;
+            }
+        } else if subdim == 2 {
+            // `compute_2x2_eigvals` of [[d0, o], [o, d1]]; the discriminant is a sum of
+            // squares, so its square root always exists.
+            let (h00, h11, h01) = (d[start], d[start + 1], o[start]);
+            let val = (h00 - h11) * 0.5;
+            let discr = h01 * h01 + val * val;
+            let sqrt_discr = discr.sqrt();
+            let half_tra = (h00 + h11) * 0.5;
+            let (e0, e1) = (half_tra + sqrt_discr, half_tra - sqrt_discr);
+            let (bx, by) = if (e0 - d[start + 1]).abs() > (e0 - d[start]).abs() {
+                (e0 - d[start + 1], o[start])
+            } else {
+                (o[start], e0 - d[start])
+            };
+            d[start] = e0;
+            d[start + 1] = e1;
+            // `GivensRotation::try_new(bx, by, eps)`.
+            let (mod0, sign0) = if bx >= 0.0 { (bx, 1.0) } else { (-bx, -1.0) };
+            let denom = (mod0 * mod0 + by * by).sqrt();
+            if denom > eps {
+                let norm = sign0 * denom;
+                rotate(&mut q, start, mod0 / denom, by / norm);
+            }
+            end -= 1;
+        }
+        (start, end) = delimit_subproblem(&d, &mut o, end, eps);
+    }
+    let eigenvalues = Vector3::new(d[0] * m_amax, d[1] * m_amax, d[2] * m_amax);
+    SymmetricEigen { eigenvectors: q, eigenvalues }
+}
+
+/// nalgebra's `wilkinson_shift`: the eigenvalue of `[[tmm, tmn], [tmn, tnn]]` nearer `tnn`.
+fn wilkinson_shift(tmm: Real, tnn: Real, tmn: Real) -> Real {
+    let sq_tmn = tmn * tmn;
+    if sq_tmn != 0.0 {
+        let d = (tmm - tnn) * 0.5;
+        tnn - sq_tmn / (d + d.signum() * (d * d + sq_tmn).sqrt())
+    } else {
+        tnn
+    }
+}
+
+/// nalgebra's `SymmetricEigen::delimit_subproblem` for a 3×3 tridiagonal matrix.
+fn delimit_subproblem(d: &[Real; 3], o: &mut [Real; 2], end: usize, eps: Real) -> (usize, usize) {
+    let mut n = end;
+    while n > 0 {
+        let m = n - 1;
+        if o[m].abs() > eps * (d[n].abs() + d[m].abs()) {
+            break;
+        }
+        n -= 1;
+    }
+    if n == 0 {
+        return (0, 0);
+    }
+    let mut new_start = n - 1;
+    while new_start > 0 {
+        let m = new_start - 1;
+        if o[m] == 0.0 || o[m].abs() <= eps * (d[new_start].abs() + d[m].abs()) {
+            o[m] = 0.0;
+            break;
+        }
+        new_start -= 1;
+    }
+    (new_start, n)
 }
 
 #[cfg(test)]
@@ -365,6 +661,85 @@ mod tests {
         let fit = PlaneAccumulator::from_points(&pts).fit(&Point3::origin()).unwrap();
         assert!(fit.plane.normal.z.abs() > 1.0 - 1e-6);
         assert!(fit.mse < 1e-8);
+    }
+
+    /// Bits of a decomposition, for exact comparison.
+    fn eigen_bits(e: &SymmetricEigen<Real, nalgebra::U3>) -> Vec<u64> {
+        e.eigenvalues.iter().chain(e.eigenvectors.iter()).map(|x| x.to_bits()).collect()
+    }
+
+    #[test]
+    fn symmetric_eigen_matches_nalgebra_bit_for_bit() {
+        // A small deterministic generator: scatter matrices of random point sets (flat, thin,
+        // blob-like, far from the origin), exactly diagonal and repeated-eigenvalue matrices.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+        };
+        let mut matrices = vec![
+            Matrix3::zeros(),
+            Matrix3::identity(),
+            Matrix3::from_diagonal(&NVector3::new(1.0, 2.0, 3.0)),
+            Matrix3::from_diagonal(&NVector3::new(3.0, 3.0, 1e-9)),
+            Matrix3::new(2.0, 1.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 5.0),
+            Matrix3::new(0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ];
+        for k in 0..20_000 {
+            let scale = [1e-6, 1e-3, 1.0, 1e3][k % 4];
+            let flat = [1.0, 0.1, 1e-3, 0.0][(k / 4) % 4];
+            let n = 3 + k % 30;
+            let mut acc = PlaneAccumulator::new();
+            let shift = Vector3::new(next(), next(), next()) * 10.0;
+            for _ in 0..n {
+                let p = Vector3::new(next(), next() * [1.0, 0.01][k % 2], next() * flat) * scale;
+                acc.add(&Point3::from(p + shift));
+            }
+            matrices.push(acc.scatter().unwrap());
+            let (a, b, c, d, e, f) = (next(), next(), next(), next(), next(), next());
+            matrices.push(Matrix3::new(a, b, c, b, d, e, c, e, f) * scale);
+        }
+        for m in matrices {
+            assert_eq!(eigen_bits(&symmetric_eigen(m)), eigen_bits(&SymmetricEigen::new(m)), "{m}");
+        }
+    }
+
+    #[test]
+    fn certified_planes_bound_the_fit() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+        };
+        let mut certified = 0;
+        for k in 0..20_000 {
+            let noise = [0.3, 0.1, 0.01, 1e-4, 0.0][k % 5];
+            let stretch = [1.0, 0.2, 0.02][(k / 5) % 3];
+            let rotation = nalgebra::Rotation3::new(Vector3::new(next(), next(), next()) * 3.0);
+            let shift = Vector3::new(next(), next(), next()) * 20.0;
+            let points: Vec<Point3> = (0..3 + k % 45)
+                .map(|_| {
+                    let p = Vector3::new(next(), next() * stretch, next() * noise);
+                    Point3::from(rotation * p + shift)
+                })
+                .collect();
+            let acc = PlaneAccumulator::from_points(&points);
+            let members: Vec<u32> = (0..points.len() as u32).collect();
+            let bounds = [acc.certified_plane(), certified_window_plane(&points, &members)];
+            for bound in bounds.into_iter().flatten() {
+                certified += 1;
+                let fit = acc.fit(&Point3::origin()).expect("certified planes have a fit");
+                assert!(bound.curvature_lower.total_cmp(&fit.curvature()).is_le(), "{k}");
+                let n = fit.plane.normal.into_inner();
+                let off = (bound.normal - n).norm().min((bound.normal + n).norm());
+                assert!(off <= bound.normal_error, "{k}: {off} > {}", bound.normal_error);
+            }
+        }
+        assert!(certified > 20_000, "{certified}");
     }
 
     #[test]

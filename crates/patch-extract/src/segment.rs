@@ -91,10 +91,17 @@
 //! k-NN neighbourhoods add O(N log N) for the tree and the queries.
 //!
 //! # Performance
-//! Release build, one core of a shared 2-core machine: a full 541 × 361 ALRF scan of
-//! scene-sim's lab (≈ 180,000 points) takes ≈ 180 ms noise-free and ≈ 270 ms at 3 cm noise;
-//! a 176 × 144 range-camera frame ≈ 25 ms (the seed fits, one 3×3 eigenproblem per pixel,
-//! are about half of it). Measured by the ignored test `measure_lab_scans` in
+//! Most seed windows are never tried (their point or a window point is taken by a region
+//! grown from a flatter seed first), so their planes are not fitted up front: the seed order
+//! and the normal test start from certified bounds on each window's curvature and normal
+//! (one cheap power step on the adjugate of the scatter matrix, with interlacing and
+//! Davis–Kahan/Kato–Temple error bounds), and a window is fitted exactly (3×3 eigenproblem)
+//! only when its seed comes up untaken or its bound cannot decide the normal test. The
+//! segmentation is exactly that of fitting every window first (same regions, same bits).
+//! Release build, one core of a shared 2-core machine: a simulated 541 × 361 ALRF scan of
+//! scene-sim's lab (≈ 190,000 points, 3 cm noise) takes ≈ 95 ms, ≈ 215 ms with every window
+//! fitted up front, `atan2` for every seed stride and the generic eigensolver (measured with
+//! `patchnav extract`'s stage times); see also the ignored test `measure_lab_scans` in
 //! `tests/segment.rs`.
 //!
 //! # Actuated LRF scans
@@ -109,11 +116,13 @@
 //! stay two), points are never moved between regions, and results depend on the seed order
 //! (deterministic for a given cloud).
 
-use crate::plane_fit::{PlaneAccumulator, PlaneFit};
+use crate::plane_fit::{PlaneAccumulator, PlaneFit, certified_window_plane};
 use crate::region::{PlanarRegion, Segmentation};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use patch_core::{Plane, Point3, Real, Vector3};
 use pointcloud::{Grid, INVALID_PIXEL, PointCloud};
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::num::NonZeroUsize;
 
 /// The assumed range noise along a surface normal: `σ(r) = sigma_0 + sigma_r2 · r²` metres at
@@ -581,6 +590,66 @@ impl<'a> Graph<'a> {
         Graph::Lists { offsets, neighbours }
     }
 
+    /// [`Graph::seed_window`] of a grid point into `members` (row-major, as there), or why
+    /// not: an incomplete window, or one wider than [`MAX_WINDOW_SPAN`] (then
+    /// [`seed_window_general`] takes it); for k-NN lists always `Incomplete`.
+    fn grid_window(&self, i: usize, members: &mut [u32; WINDOW_CAPACITY]) -> GridWindow {
+        let Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs } = self else {
+            return GridWindow::Incomplete;
+        };
+        let (w, h, s) = (grid.width(), grid.height(), *seed_radius);
+        let pixel = pixel_of[i];
+        let (col, row) = (pixel % w, pixel / w);
+        let [tc, tr] = strides[i].map(u32::from);
+        let (sc, sr) = (s * tc, s * tr);
+        if tc == 0 || tr == 0 || col < sc || row < sr || col + sc >= w || row + sr >= h {
+            return GridWindow::Incomplete;
+        }
+        let span = 2 * s as usize + 1;
+        if span > MAX_WINDOW_SPAN {
+            return GridWindow::Wide;
+        }
+        // A member (c, r) is joined to the centre along the centre's row, then along its
+        // column (`row_then_column`), or the other way round; the parts that depend on the
+        // column or row alone are looked up once per column and row.
+        let (wu, tcu, tru) = (w as usize, tc as usize, tr as usize);
+        let (c0, r0, centre) = ((col - sc) as usize, (row - sr) as usize, pixel as usize);
+        let centre_row_run = row_runs[centre];
+        let centre_col_run = col_runs[centre];
+        let row_base = row as usize * wu;
+        // Per window column: whether the centre's row run reaches it, and its column run at
+        // the centre's row.
+        let mut by_column = [(false, 0u32); MAX_WINDOW_SPAN];
+        for (k, slot) in by_column.iter_mut().take(span).enumerate() {
+            let c = c0 + k * tcu;
+            *slot = (centre_row_run == row_runs[row_base + c], col_runs[row_base + c]);
+        }
+        let pixels = grid.pixels();
+        let mut len = 0;
+        let mut chained = true;
+        for kr in 0..span {
+            let base = (r0 + kr * tru) * wu;
+            // Whether the centre's column run reaches this row, and the row run of the
+            // centre's column at this row.
+            let column_reaches = centre_col_run == col_runs[base + col as usize];
+            let row_run_here = row_runs[base + col as usize];
+            for (kc, &(row_reaches, column_run)) in by_column.iter().take(span).enumerate() {
+                let at = base + c0 + kc * tcu;
+                let p = pixels[at];
+                if p == INVALID_PIXEL {
+                    return GridWindow::Incomplete;
+                }
+                members[len] = p;
+                len += 1;
+                if chained {
+                    chained = (row_reaches && column_run == col_runs[at])
+                        || (column_reaches && row_run_here == row_runs[at]);
+                }
+            }
+        }
+        GridWindow::Members(len, chained)
+    }
+
     /// The growth neighbours of point `i`.
     fn neighbours(&self, i: usize, out: &mut Vec<u32>) {
         out.clear();
@@ -620,30 +689,28 @@ impl<'a> Graph<'a> {
         out.clear();
         match self {
             Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs } => {
-                let (w, h, s) = (grid.width(), grid.height(), *seed_radius);
-                let pixel = pixel_of[i];
-                let (col, row) = (pixel % w, pixel / w);
-                let [tc, tr] = strides[i].map(u32::from);
-                let (sc, sr) = (s * tc, s * tr);
-                if tc == 0 || tr == 0 || col < sc || row < sr || col + sc >= w || row + sr >= h {
-                    return None;
-                }
-                let at = |c: u32, r: u32| (r * w + c) as usize;
-                let joined = |c: u32, r: u32| {
-                    let row_then_column = row_runs[at(col, row)] == row_runs[at(c, row)]
-                        && col_runs[at(c, row)] == col_runs[at(c, r)];
-                    row_then_column
-                        || (col_runs[at(col, row)] == col_runs[at(col, r)]
-                            && row_runs[at(col, r)] == row_runs[at(c, r)])
-                };
-                let mut chained = true;
-                for r in (row - sr..=row + sr).step_by(tr as usize) {
-                    for c in (col - sc..=col + sc).step_by(tc as usize) {
-                        out.push((grid.point_index(c, r)? as u32, 0));
-                        chained &= joined(c, r);
+                let mut members = [0u32; WINDOW_CAPACITY];
+                match self.grid_window(i, &mut members) {
+                    GridWindow::Members(len, chained) => {
+                        out.extend(members[..len].iter().map(|&p| (p, 0)));
+                        Some(chained)
+                    }
+                    GridWindow::Incomplete => None,
+                    GridWindow::Wide => {
+                        let (w, s) = (grid.width(), *seed_radius);
+                        let pixel = pixel_of[i];
+                        let [tc, tr] = strides[i].map(u32::from);
+                        seed_window_general(
+                            grid,
+                            row_runs,
+                            col_runs,
+                            (pixel % w, pixel / w),
+                            (s * tc, s * tr),
+                            (tc, tr),
+                            out,
+                        )
                     }
                 }
-                Some(chained)
             }
             Graph::Lists { offsets, neighbours } => {
                 let list = &neighbours[offsets[i] as usize..offsets[i + 1] as usize];
@@ -688,6 +755,53 @@ impl<'a> Graph<'a> {
                 && walk((c, row), (c, row + sr))
         })
     }
+}
+
+/// The most pixels along one direction of a seed window that [`Graph::grid_window`] handles
+/// on the stack (`seed_radius` ≤ 3); wider windows take [`seed_window_general`].
+const MAX_WINDOW_SPAN: usize = 7;
+
+/// The most members of a window [`Graph::grid_window`] handles.
+const WINDOW_CAPACITY: usize = MAX_WINDOW_SPAN * MAX_WINDOW_SPAN;
+
+/// What [`Graph::grid_window`] found.
+enum GridWindow {
+    /// The window is complete: its first `.0` members, chained (`.1`) or not.
+    Members(usize, bool),
+    /// Not a complete window (or not a grid).
+    Incomplete,
+    /// Too wide for the stack: use [`Graph::seed_window`].
+    Wide,
+}
+
+/// [`Graph::seed_window`] of the pixel (`col`, `row`) for any window size: half-extents
+/// `(sc, sr)` and strides `(tc, tr)` in pixels, the window inside the grid.
+fn seed_window_general(
+    grid: &Grid,
+    row_runs: &[u32],
+    col_runs: &[u32],
+    (col, row): (u32, u32),
+    (sc, sr): (u32, u32),
+    (tc, tr): (u32, u32),
+    out: &mut Vec<(u32, u32)>,
+) -> Option<bool> {
+    let w = grid.width();
+    let at = |c: u32, r: u32| (r * w + c) as usize;
+    let joined = |c: u32, r: u32| {
+        let row_then_column = row_runs[at(col, row)] == row_runs[at(c, row)]
+            && col_runs[at(c, row)] == col_runs[at(c, r)];
+        row_then_column
+            || (col_runs[at(col, row)] == col_runs[at(col, r)]
+                && row_runs[at(col, r)] == row_runs[at(c, r)])
+    };
+    let mut chained = true;
+    for r in (row - sr..=row + sr).step_by(tr as usize) {
+        for c in (col - sc..=col + sc).step_by(tc as usize) {
+            out.push((grid.point_index(c, r)? as u32, 0));
+            chained &= joined(c, r);
+        }
+    }
+    Some(chained)
 }
 
 /// The default [`SegmentConfig::seed_min_extent`] of [`SegmentConfig::alrf`]: 3σ, so 9 cm at
@@ -739,37 +853,96 @@ fn seed_strides(
     if config.seed_min_extent <= 0.0 {
         return vec![[1, 1]; points.len()];
     }
-    let (w, h, s) = (grid.width(), grid.height(), config.seed_radius);
-    let direction = |c: u32, r: u32| grid.point_index(c, r).map(|p| points[p].coords);
-    let angle = |a: Vector3, b: Vector3| a.cross(&b).norm().atan2(a.dot(&b));
+    let (w, h, s) = (grid.width() as usize, grid.height() as usize, config.seed_radius as usize);
+    let pixels = grid.pixels();
+    // Per pixel: the unit direction of its point (NaN without a point or for the origin,
+    // where the quick test leaves the decision to the full one).
+    let unit: Vec<Vector3> = pixels
+        .iter()
+        .map(|&p| match p {
+            INVALID_PIXEL => Vector3::repeat(Real::NAN),
+            p => points[p as usize].coords / points[p as usize].coords.norm(),
+        })
+        .collect();
     points
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let range = p.coords.norm();
+            if range.is_nan() || range <= 0.0 || pixel_of[i] == INVALID_PIXEL {
+                return [0, 0];
+            }
             let needed = config.seed_min_extent * config.noise.sigma(range) / range;
-            let (col, row) = (pixel_of[i] % w, pixel_of[i] / w);
-            let stride = |along_columns: bool| -> u8 {
-                for t in 1..=MAX_SEED_STRIDE {
-                    let d = s * t;
-                    let ends = if along_columns {
-                        (col >= d && col + d < w)
-                            .then(|| (direction(col - d, row), direction(col + d, row)))
-                    } else {
-                        (row >= d && row + d < h)
-                            .then(|| (direction(col, row - d), direction(col, row + d)))
-                    };
-                    match ends {
-                        Some((Some(a), Some(b))) if angle(a, b) >= needed => return t as u8,
-                        Some(_) => {}
-                        None => return 0,
+            let wide_enough = AngleTest { needed };
+            let pixel = pixel_of[i] as usize;
+            let (col, row) = (pixel % w, pixel / w);
+            // The first stride whose window ends (`step` pixels apart per unit of stride
+            // along the grid) are both measured and wide enough, if the window stays inside
+            // the grid up to it.
+            let stride = |step: usize, room: usize| -> u8 {
+                let last = (room / s).min(MAX_SEED_STRIDE as usize);
+                for t in 1..=last {
+                    let (a, b) = (pixel - s * t * step, pixel + s * t * step);
+                    let wide = wide_enough.quick(&unit[a], &unit[b]).unwrap_or_else(|| {
+                        match (pixels[a], pixels[b]) {
+                            (INVALID_PIXEL, _) | (_, INVALID_PIXEL) => false,
+                            (a, b) => wide_enough.exact(&points[a as usize], &points[b as usize]),
+                        }
+                    });
+                    if wide {
+                        return t as u8;
                     }
                 }
                 0
             };
-            if range > 0.0 { [stride(true), stride(false)] } else { [0, 0] }
+            [stride(1, col.min(w - 1 - col)), stride(w, row.min(h - 1 - row))]
         })
         .collect()
+}
+
+/// The test `angle(a, b) ≥ needed` of [`seed_strides`] for the angle
+/// `atan2(|a × b|, a · b)` between two beam directions, decided without `atan2` where the
+/// answer is certain: the chord `c = |â − b̂|` between the unit directions and the angle `θ`
+/// satisfy `c ≤ θ ≤ c + c³/20` for `c ≤ 1` (`θ = 2 asin(c/2)`). Near the threshold (within
+/// `1e-9`, far beyond the `1e-15` or so of rounding in either form) it evaluates `atan2`
+/// itself, so the answer is always that of the plain `atan2` comparison.
+struct AngleTest {
+    needed: Real,
+}
+
+impl AngleTest {
+    /// The answer where the chord decides it.
+    fn quick(&self, unit_a: &Vector3, unit_b: &Vector3) -> Option<bool> {
+        // Compared squared: `chord ≥ needed + margin`, and for `chord ≤ 1`
+        // `chord (1 + chord² / 20) < needed − margin` (rounding stays far inside the margin).
+        let chord2 = (unit_a - unit_b).norm_squared();
+        let margin = 1e-9 * (1.0 + self.needed);
+        let high = self.needed + margin;
+        if chord2 >= high * high {
+            return Some(true);
+        }
+        let low = self.needed - margin;
+        if chord2 <= 1.0 && low > 0.0 && {
+            let stretch = 1.0 + chord2 * 0.05;
+            chord2 * stretch * stretch < low * low
+        } {
+            return Some(false);
+        }
+        None
+    }
+
+    /// The plain test.
+    fn exact(&self, a: &Point3, b: &Point3) -> bool {
+        let (a, b) = (a.coords, b.coords);
+        a.cross(&b).norm().atan2(a.dot(&b)) >= self.needed
+    }
+
+    /// The test for points `a`, `b` with unit directions `unit_a`, `unit_b`.
+    #[cfg(test)]
+    fn passes(&self, a: &Vector3, b: &Vector3, unit_a: &Vector3, unit_b: &Vector3) -> bool {
+        self.quick(unit_a, unit_b)
+            .unwrap_or_else(|| self.exact(&Point3::from(*a), &Point3::from(*b)))
+    }
 }
 
 /// Per pixel, the first pixel of its run of linked pixels along its row and along its column
@@ -894,6 +1067,13 @@ fn height_variance(fit: &PlaneFit, up: &Vector3) -> Real {
         / n
 }
 
+/// An integer whose order is [`f64::total_cmp`]'s order of `x` (the key `total_cmp` itself
+/// compares).
+fn total_order_key(x: Real) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ ((((bits >> 63) as u64) >> 1) as i64)
+}
+
 const FREE: u32 = u32::MAX;
 /// Owner of the points of a region rejected by the bending test: in no region, never reused.
 const BENT: u32 = u32::MAX - 1;
@@ -940,6 +1120,29 @@ fn bending(
     drop.is_finite().then_some(drop.max(0.0))
 }
 
+/// A seed in the seed order, packed so that integer order is the order of its window's
+/// curvature (a lower bound of it until `fitted`) in [`f64::total_cmp`] order, then of its
+/// point: the curvature's order key with its sign bit flipped (signed to unsigned order) in
+/// the top 64 bits, the point in the next 32, whether the curvature is the fitted one in the
+/// lowest bit.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Seed(u128);
+
+impl Seed {
+    fn new(curvature: Real, point: u32, fitted: bool) -> Seed {
+        let key = (total_order_key(curvature) as u64) ^ (1 << 63);
+        Seed(((key as u128) << 64) | ((point as u128) << 1) | fitted as u128)
+    }
+
+    fn point(self) -> usize {
+        ((self.0 >> 1) as u32) as usize
+    }
+
+    fn fitted(self) -> bool {
+        self.0 & 1 == 1
+    }
+}
+
 struct Grown {
     points: Vec<u32>,
     acc: PlaneAccumulator,
@@ -953,19 +1156,60 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector
     let origin = Point3::origin();
     let min_normal_cos = config.max_normal_angle.map_or(-1.0, Real::cos);
 
-    // Seed order: flattest windows first.
+    // Seed order: flattest windows first. Most seeds are never tried (their point or window
+    // is taken by then), so a window's plane is fitted only when it must be: with certified
+    // bounds on its curvature and normal ([`PlaneAccumulator::certified_plane`]) a seed is
+    // queued at its curvature's lower bound and fitted when it comes up with its point and
+    // window still free, then tried at once if no other seed comes before its exact
+    // curvature, else queued again at its exact curvature; the normal test fits
+    // a window only when the bound cannot decide it. Taken points stay taken between seeds
+    // (a dissolved region frees only the points it took), so a seed skipped early would be
+    // skipped at its exact turn too, and seeds are tried in exactly the order of their
+    // fitted curvatures (ties by index).
     let mut window = Vec::new();
-    let mut seeds: Vec<(Real, u32)> = Vec::new();
+    let mut seeds: Vec<Seed> = Vec::new();
     // Per point: its seed window's plane normal (zero without a complete window, which
-    // passes the normal test).
+    // passes the normal test) and how far it may be from the fitted one (0: fitted).
     let mut window_normal =
-        vec![Vector3::zeros(); if config.max_normal_angle.is_some() { n } else { 0 }];
+        vec![(Vector3::zeros(), 0.0); if config.max_normal_angle.is_some() { n } else { 0 }];
+    let mut members = [0u32; WINDOW_CAPACITY];
     for i in 0..n {
-        let Some(chained) = graph.seed_window(i, &mut window) else { continue };
-        if !window.iter().all(|&(p, steps)| steps == 0 || tests.linked(i, p as usize, steps)) {
+        // Grid windows straight from the pixels; others (k-NN lists, wide windows) as listed.
+        let (chained, acc) = match graph.grid_window(i, &mut members) {
+            GridWindow::Members(len, chained) => {
+                let members = &members[..len];
+                if chained && let Some(bound) = certified_window_plane(points, members) {
+                    seeds.push(Seed::new(bound.curvature_lower, i as u32, false));
+                    if let Some(slot) = window_normal.get_mut(i) {
+                        *slot = (bound.normal, bound.normal_error);
+                    }
+                    continue;
+                }
+                let acc =
+                    PlaneAccumulator::from_points(members.iter().map(|&p| &points[p as usize]));
+                (chained, acc)
+            }
+            GridWindow::Incomplete if matches!(graph, Graph::Grid { .. }) => continue,
+            _ => {
+                let Some(chained) = graph.seed_window(i, &mut window) else { continue };
+                if !window
+                    .iter()
+                    .all(|&(p, steps)| steps == 0 || tests.linked(i, p as usize, steps))
+                {
+                    continue;
+                }
+                let acc =
+                    PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
+                (chained, acc)
+            }
+        };
+        if chained && let Some(bound) = acc.certified_plane() {
+            seeds.push(Seed::new(bound.curvature_lower, i as u32, false));
+            if let Some(slot) = window_normal.get_mut(i) {
+                *slot = (bound.normal, bound.normal_error);
+            }
             continue;
         }
-        let acc = PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
         if let Some(fit) = acc.fit(&origin) {
             if !chained {
                 // A window across pixels the plain jump test does not chain seeds only a
@@ -977,20 +1221,39 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector
                     _ => continue,
                 }
             }
-            seeds.push((fit.curvature(), i as u32));
+            seeds.push(Seed::new(fit.curvature(), i as u32, true));
             if let Some(slot) = window_normal.get_mut(i) {
-                *slot = fit.plane.normal.into_inner();
+                *slot = (fit.plane.normal.into_inner(), 0.0);
             }
         }
     }
-    seeds.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    // Flattest first, ties by index: the keys are distinct (one per point), so an unstable
+    // sort on the integer image of `total_cmp` gives the same order as a stable one.
+    seeds.sort_unstable();
+    // Seeds fitted on the way, by exact curvature.
+    let mut fitted: BinaryHeap<Reverse<Seed>> = BinaryHeap::new();
+    let mut next_seed = 0;
+    let mut scratch = Vec::new();
 
     let mut owner = vec![FREE; n];
     let mut grown: Vec<Grown> = Vec::new();
     let mut queue: Vec<u32> = Vec::new();
     let mut nbrs = Vec::new();
-    for &(_, seed) in &seeds {
-        let seed = seed as usize;
+    loop {
+        let from_list = match (seeds.get(next_seed), fitted.peek()) {
+            (Some(s), Some(Reverse(f))) => s < f,
+            (Some(_), None) => true,
+            (None, Some(_)) => false,
+            (None, None) => break,
+        };
+        let (seed, unfitted) = if from_list {
+            let s = seeds[next_seed];
+            next_seed += 1;
+            (s.point(), !s.fitted())
+        } else {
+            let Some(Reverse(s)) = fitted.pop() else { break };
+            (s.point(), false)
+        };
         if owner[seed] != FREE {
             continue;
         }
@@ -1001,6 +1264,17 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector
         let mut acc =
             PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
         let Some(fit) = acc.fit(&origin) else { continue };
+        if unfitted {
+            // Its turn comes now unless another seed comes before its exact curvature; then
+            // it waits for its turn (its point and window are checked again then).
+            let exact = Seed::new(fit.curvature(), seed as u32, true);
+            if seeds.get(next_seed).is_some_and(|s| *s < exact)
+                || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
+            {
+                fitted.push(Reverse(exact));
+                continue;
+            }
+        }
         let mut sum_sigma2: Real =
             window.iter().map(|&(p, _)| tests.sigma[p as usize].powi(2)).sum();
         if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
@@ -1027,8 +1301,31 @@ fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector
                 if owner[m] != FREE
                     || !tests.linked_on(&plane, q, m)
                     || !tests.near_plane(&plane, m)
-                    || window_normal.get(m).is_some_and(|w| {
-                        *w != Vector3::zeros() && w.dot(&plane.normal).abs() < min_normal_cos
+                    || window_normal.get_mut(m).is_some_and(|w| {
+                        let refused = |w: &Vector3| {
+                            *w != Vector3::zeros() && w.dot(&plane.normal).abs() < min_normal_cos
+                        };
+                        let (normal, error) = *w;
+                        if error == 0.0 {
+                            return refused(&normal);
+                        }
+                        let cos = normal.dot(&plane.normal).abs();
+                        if cos - error > min_normal_cos + 1e-12 {
+                            return false;
+                        }
+                        if cos + error < min_normal_cos - 1e-12 {
+                            return true;
+                        }
+                        // The bound cannot decide: fit the window.
+                        let _ = graph.seed_window(m, &mut scratch);
+                        let acc = PlaneAccumulator::from_points(
+                            scratch.iter().map(|&(p, _)| &points[p as usize]),
+                        );
+                        let normal = acc
+                            .fit(&origin)
+                            .map_or(Vector3::zeros(), |f| f.plane.normal.into_inner());
+                        *w = (normal, 0.0);
+                        refused(&normal)
                     })
                 {
                     continue;
@@ -1095,5 +1392,69 @@ fn region_from_fit(points: Vec<u32>, fit: &PlaneFit) -> PlanarRegion {
         centroid: fit.centroid,
         mse: fit.mse,
         covariance: fit.covariance(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random(state: &mut u64) -> Real {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+    }
+
+    #[test]
+    fn angle_test_agrees_with_atan2() {
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let exact =
+            |a: &Vector3, b: &Vector3, needed: Real| a.cross(b).norm().atan2(a.dot(b)) >= needed;
+        for k in 0..200_000 {
+            let a = Vector3::new(random(&mut state), random(&mut state), random(&mut state))
+                * (0.1 + 10.0 * random(&mut state).abs());
+            let turn = [1e-4, 1e-2, 0.3, 2.0][k % 4] * random(&mut state);
+            let axis = Vector3::new(random(&mut state), random(&mut state), random(&mut state));
+            let b = nalgebra::Rotation3::new(axis.normalize() * turn) * a * 1.7;
+            let angle = a.cross(&b).norm().atan2(a.dot(&b));
+            // Thresholds at the angle itself (to the last bits), near it and far from it.
+            let needed = match k % 5 {
+                0 => angle,
+                1 => angle * (1.0 + 1e-15),
+                2 => angle * (1.0 - 1e-12),
+                3 => angle * (1.0 + 1e-6),
+                _ => random(&mut state).abs() * 3.0,
+            };
+            let test = AngleTest { needed };
+            let (ua, ub) = (a / a.norm(), b / b.norm());
+            assert_eq!(test.passes(&a, &b, &ua, &ub), exact(&a, &b, needed), "{k}");
+        }
+        let zero = Vector3::zeros();
+        let nan = zero / zero.norm();
+        let a = Vector3::x();
+        assert_eq!(AngleTest { needed: 0.1 }.passes(&zero, &a, &nan, &a), exact(&zero, &a, 0.1));
+    }
+
+    #[test]
+    fn total_order_key_orders_as_total_cmp() {
+        let values = [
+            Real::NEG_INFINITY,
+            -1.0,
+            -Real::MIN_POSITIVE,
+            -0.0,
+            0.0,
+            Real::MIN_POSITIVE,
+            1e-300,
+            0.5,
+            1.0,
+            Real::INFINITY,
+            Real::NAN,
+        ];
+        for a in values {
+            for b in values {
+                assert_eq!(total_order_key(a).cmp(&total_order_key(b)), a.total_cmp(&b));
+            }
+        }
     }
 }
