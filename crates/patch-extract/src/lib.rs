@@ -52,6 +52,7 @@ pub mod region;
 pub mod scanline;
 pub mod segment;
 pub mod simplify;
+pub mod slab;
 pub mod spherical_grid;
 pub mod trimesh_grow;
 
