@@ -19,6 +19,7 @@
 //! thesis App. A), which needs the scan's beam model and so is the caller's step.
 
 use crate::denoise::{BeamDenoiseConfig, DenoiseError, denoise_along_beams_where};
+use crate::fill::{FillError, fill_upward_holes};
 use crate::grid_mesh::RegionMask;
 use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
@@ -27,7 +28,7 @@ use crate::segment::{SegmentConfig, SegmentError, segment};
 use crate::slab::{SlabError, back_faces};
 use crate::spherical_grid::{SphericalGridConfig, SphericalGridError, mesh_unorganised};
 use crate::trimesh_grow::{GrownTrimeshes, TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
-use patch_core::{Isometry3, Patch, PlanarPatch, Real};
+use patch_core::{Isometry3, Patch, PlanarPatch, Real, Vector3};
 use pointcloud::PointCloud;
 use std::time::{Duration, Instant};
 
@@ -36,6 +37,10 @@ use std::time::{Duration, Instant};
 /// map unsafe / overcautious %): none 2.77 / 1.28, 2 cm 2.41 / 1.40, 4 cm 2.12 / 1.52,
 /// 6 cm 1.97 / 1.71, 8 cm 1.85 / 1.91.
 pub const ALRF_SLAB_THICKNESS: Real = 0.04;
+
+/// [`PipelineConfig::alrf`]'s tilt limit for filling holes, radians (30°): floors and table
+/// tops, and ramps a wheeled robot drives on.
+pub const ALRF_FILL_TILT: Real = std::f64::consts::FRAC_PI_6;
 
 /// Every stage's parameters. No `Default`: start from a sensor preset.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,6 +70,10 @@ pub struct PipelineConfig {
     /// was seen from, so that maps hold slabs ([`crate::slab`], not in the thesis); `None`:
     /// bare surfaces.
     pub slab_thickness: Option<Real>,
+    /// After merging, the holes of planar patches facing up (normal within this many radians
+    /// of the world's +z) are filled ([`crate::fill`], not in the thesis); `None`: outlines
+    /// keep their holes.
+    pub fill_upward_holes: Option<Real>,
 }
 
 impl PipelineConfig {
@@ -72,7 +81,8 @@ impl PipelineConfig {
     /// [`PolygonizeConfig::conservative`] (outlines grown to cover what the scan saw),
     /// merging with [`MergeConfig::alrf`], no remainder meshes, no mixed-pixel filter (on the
     /// lab it removes real obstacle points: planes map unsafe 2.8 → 3.7 %; see
-    /// `patchnav experiment map-safety`), slabs [`ALRF_SLAB_THICKNESS`] thick.
+    /// `patchnav experiment map-safety`), the holes of upward-facing patches filled
+    /// ([`ALRF_FILL_TILT`]), slabs [`ALRF_SLAB_THICKNESS`] thick.
     pub fn alrf() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::alrf(),
@@ -83,6 +93,7 @@ impl PipelineConfig {
             unorganised: Some(SphericalGridConfig::estimated()),
             denoise: Some(BeamDenoiseConfig::alrf()),
             slab_thickness: Some(ALRF_SLAB_THICKNESS),
+            fill_upward_holes: Some(ALRF_FILL_TILT),
         }
     }
 
@@ -96,6 +107,7 @@ impl PipelineConfig {
             polygonize: PolygonizeConfig::thesis(),
             denoise: None,
             slab_thickness: None,
+            fill_upward_holes: None,
             ..PipelineConfig::alrf()
         }
     }
@@ -112,6 +124,7 @@ impl PipelineConfig {
             unorganised: Some(SphericalGridConfig::estimated()),
             denoise: None,
             slab_thickness: None,
+            fill_upward_holes: None,
         }
     }
 
@@ -127,6 +140,7 @@ impl PipelineConfig {
             unorganised: Some(SphericalGridConfig::estimated()),
             denoise: None,
             slab_thickness: None,
+            fill_upward_holes: None,
         }
     }
 
@@ -142,6 +156,7 @@ impl PipelineConfig {
             unorganised: Some(SphericalGridConfig::estimated()),
             denoise: None,
             slab_thickness: None,
+            fill_upward_holes: None,
         }
     }
 
@@ -186,6 +201,9 @@ pub enum ExtractError {
     /// The slab thickness is out of range.
     #[error(transparent)]
     Slab(#[from] SlabError),
+    /// The tilt limit for filling holes is out of range.
+    #[error(transparent)]
+    Fill(#[from] FillError),
     /// Beam denoising refused its parameters.
     #[error("scan {scan}: beam denoising: {source}")]
     Denoise {
@@ -275,6 +293,8 @@ pub struct Extraction {
     /// The planar patches' back faces ([`PipelineConfig::slab_thickness`]), in their order;
     /// empty without.
     pub back_faces: Vec<Patch>,
+    /// Holes filled in upward-facing patches ([`PipelineConfig::fill_upward_holes`]).
+    pub filled_holes: usize,
     /// One report per scan.
     pub scans: Vec<ScanReport>,
     /// What merging did, if it ran.
@@ -412,6 +432,9 @@ pub fn extract(
         planar = merged;
         out.merge = Some(stats);
         out.times.merging += t.elapsed();
+    }
+    if let Some(tilt) = config.fill_upward_holes {
+        out.filled_holes = fill_upward_holes(&mut planar, &Vector3::z(), tilt)?;
     }
     if let Some(t) = config.slab_thickness {
         out.back_faces = back_faces(&planar, t)?.into_iter().map(Patch::Planar).collect();

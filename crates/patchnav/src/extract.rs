@@ -278,6 +278,9 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     )?;
     let planar = result.patches.iter().filter(|p| p.as_planar().is_some()).count();
     write!(out, "patches: {planar} planar, {} trimesh", result.patches.len() - planar)?;
+    if result.filled_holes > 0 {
+        write!(out, "; {} holes of upward surfaces filled", result.filled_holes)?;
+    }
     match config.slab_thickness {
         Some(t) if !result.back_faces.is_empty() => {
             writeln!(out, "; in the map with {} back faces {t} m behind", result.back_faces.len())?
