@@ -33,9 +33,12 @@ use pointcloud::PointCloud;
 use std::time::{Duration, Instant};
 
 /// [`PipelineConfig::alrf`]'s slab thickness, metres: the thinnest boards and table tops of
-/// indoor scenes (2–4 cm). Measured on the lab (8 scans, scene seed 0, step seed 1; planes
-/// map unsafe / overcautious %): none 2.77 / 1.28, 2 cm 2.41 / 1.40, 4 cm 2.12 / 1.52,
-/// 6 cm 1.97 / 1.71, 8 cm 1.85 / 1.91.
+/// indoor scenes (2–4 cm). Measured on the lab (8 scans, scene seed 0, step seed 1, holes not
+/// filled; unsafe / overcautious %): planes map none 2.77 / 1.28, 2 cm 2.41 / 1.40, 4 cm
+/// 2.12 / 1.52, 6 cm 1.97 / 1.71, 8 cm 1.85 / 1.91; hybrid map none 1.16 / 1.85, 2 cm
+/// 0.92 / 1.94, 4 cm 0.76 / 2.05, 6 cm 0.71 / 2.21, 8 cm 0.64 / 2.39. With the holes filled,
+/// 3 cm gives planes 2.01 / 1.46 and hybrid 0.62 / 2.00, 4 cm 1.87 / 1.52 and 0.53 / 2.05:
+/// the safer one is kept.
 pub const ALRF_SLAB_THICKNESS: Real = 0.04;
 
 /// [`PipelineConfig::alrf`]'s tilt limit for filling holes, radians (30°): floors and table
