@@ -24,6 +24,8 @@
 //! | outline merging across scans | [`merge`] | §5.1 |
 //! | range denoising along the beams (trimesh, hybrid and point-cloud maps) | [`denoise`] | — (ours) |
 //! | conservative outline offset | [`offset`] | — (ours) |
+//! | holes of upward-facing patches filled, after merging | [`fill`] | — (ours) |
+//! | slabs: a back face behind each planar patch, for maps | [`slab`] | — (ours) |
 //! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
 //!
 //! Every parameter the thesis leaves open (segmentation thresholds, α rule details, DP ε,
@@ -38,6 +40,7 @@ pub mod alpha_shape;
 pub mod chain_code;
 pub mod denoise;
 pub mod evaluate;
+pub mod fill;
 pub mod grid_mesh;
 pub mod hull;
 pub mod merge;
@@ -52,6 +55,7 @@ pub mod region;
 pub mod scanline;
 pub mod segment;
 pub mod simplify;
+pub mod slab;
 pub mod spherical_grid;
 pub mod trimesh_grow;
 

@@ -673,7 +673,7 @@ mod tests {
 
     /// The safety contract on a small case (lab, seed 0, 4 scans at 2°, fast in the dev
     /// profile): extraction must not lose more of what the scans saw. Today: floor (pc) 13.8 %,
-    /// planes 26.4 %, hybrid 19.0 % unsafe (coarse scans hold fewer points per region than the
+    /// planes 27.8 %, hybrid 19.1 % unsafe (coarse scans hold fewer points per region than the
     /// 0.5° scans of `experiment map-safety`); the bounds sit a little above and fail if the
     /// planes or hybrid map lets noticeably more collisions through.
     #[test]

@@ -481,8 +481,10 @@ pub fn extracted_patches_with(
     grow: TrimeshGrowConfig,
 ) -> Result<Option<Vec<Patch>>> {
     Ok(match kind {
-        MapKind::Planes => Some(extract(clouds, &pipeline, |_| {})?.patches),
-        MapKind::Hybrid => Some(extract(clouds, &pipeline.with_remainder(grow), |_| {})?.patches),
+        MapKind::Planes => Some(extract(clouds, &pipeline, |_| {})?.into_map_patches()),
+        MapKind::Hybrid => {
+            Some(extract(clouds, &pipeline.with_remainder(grow), |_| {})?.into_map_patches())
+        }
         MapKind::Trimesh => {
             let mut patches = Vec::new();
             for cloud in clouds {

@@ -1269,6 +1269,7 @@ fn map_size_section(
     let t = Instant::now();
     let config = PipelineConfig {
         merge: None,
+        slab_thickness: None,
         ..PipelineConfig::alrf().with_remainder(TrimeshGrowConfig::alrf())
     };
     let extraction = extract(&scans, &config, |_| {})?;
