@@ -127,6 +127,13 @@ pub struct AlphaShapeConfig {
     pub components: ComponentPolicy,
     /// Which holes to keep.
     pub holes: HoleFilter,
+    /// The largest α the optimal and robust choices may take, metres (> 0; not in the
+    /// thesis); `None`: no limit. An α-shape closes every opening narrower than 2α, so a
+    /// region seen sparsely (a wall far along a corridor) whose optimal α is half a metre
+    /// closes its doorways. Above the limit the shape may have more components than asked
+    /// for and leave more points out; [`ComponentPolicy::All`] keeps every component. If no
+    /// triangle is small enough, the limit is not applied.
+    pub max_alpha: Option<Real>,
 }
 
 impl AlphaShapeConfig {
@@ -142,6 +149,7 @@ impl AlphaShapeConfig {
             alpha: AlphaChoice::Optimal { max_components: 1 },
             components: ComponentPolicy::Largest,
             holes: HoleFilter::AlphaScaled(4.0 * std::f64::consts::PI),
+            max_alpha: None,
         }
     }
 
@@ -154,12 +162,23 @@ impl AlphaShapeConfig {
         }
     }
 
+    /// [`AlphaShapeConfig::robust`] with α at most `max_alpha` metres and every component
+    /// kept: openings wider than `2 · max_alpha` stay open.
+    pub fn robust_at_most(max_alpha: Real) -> AlphaShapeConfig {
+        AlphaShapeConfig {
+            components: ComponentPolicy::All,
+            max_alpha: Some(max_alpha),
+            ..AlphaShapeConfig::robust()
+        }
+    }
+
     /// The exact regularized α-complex for a fixed radius: all components, all holes.
     pub fn with_radius(alpha: Real) -> AlphaShapeConfig {
         AlphaShapeConfig {
             alpha: AlphaChoice::Radius(alpha),
             components: ComponentPolicy::All,
             holes: HoleFilter::KeepAll,
+            max_alpha: None,
         }
     }
 }
@@ -511,6 +530,11 @@ pub fn alpha_shape(
     {
         return Err(AlphaShapeError::InvalidAlpha { value: v });
     }
+    if let Some(m) = config.max_alpha
+        && !(m.is_finite() && m > 0.0)
+    {
+        return Err(AlphaShapeError::InvalidAlpha { value: m });
+    }
     let mesh = build_mesh(points)?;
     // With the search's union–find: the components of the triangles it added.
     let (alpha_squared, searched) = match config.alpha {
@@ -524,6 +548,18 @@ pub fn alpha_shape(
             let (alpha_squared, uf, added) = optimal_alpha_squared(&mesh, max_components, allowed);
             (alpha_squared, Some((uf, added)))
         }
+    };
+    // The limit (not for a given radius): the search's union–find then joined triangles above
+    // it, so the components are found afresh.
+    let (alpha_squared, searched) = match config.max_alpha {
+        Some(m)
+            if !matches!(config.alpha, AlphaChoice::Radius(_))
+                && alpha_squared > m * m
+                && mesh.radius2.iter().any(|&r2| r2 <= m * m) =>
+        {
+            (m * m, None)
+        }
+        _ => (alpha_squared, searched),
     };
     let alpha = alpha_squared.sqrt();
     let min_hole_area = match config.holes {

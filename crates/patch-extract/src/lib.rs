@@ -11,7 +11,7 @@
 //! | region growing segmentation | [`mod@segment`] | Poppinga et al. 2008, undescribed in the thesis: our method is documented in the module |
 //! | segmentation quality (SegComp, Hoover et al. 1996) | [`evaluate`] | — |
 //! | projection: early/late, orthogonal/along the beam; ALRF ±90° columns | [`projection`] | §5.3.2, App. A |
-//! | α-shapes with the optimal α for one component | [`alpha_shape`] | Alg 6, L4839–4909 |
+//! | α-shapes with the optimal α for one component (ours: a robust α, an α limit) | [`alpha_shape`] | Alg 6, L4839–4909 |
 //! | convex hull | [`hull`] | survey, L4811 |
 //! | naive range-image triangulation | [`grid_mesh`] | L4913–4915 |
 //! | convex grid polygons (scanLine V1, V2) | [`scanline`] | Alg 7, Alg 8, L4911–5146 |

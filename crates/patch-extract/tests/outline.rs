@@ -155,6 +155,7 @@ fn optimal_alpha_gives_one_component_and_a_smaller_alpha_splits() {
             alpha: AlphaChoice::Radius(0.9 * alpha),
             components: ComponentPolicy::Largest,
             holes: HoleFilter::KeepAll,
+            max_alpha: None,
         },
     )
     .unwrap();
@@ -655,4 +656,22 @@ fn robust_alpha_leaves_stray_points_out() {
             "{max_components} {max_uncovered}"
         );
     }
+}
+
+/// A wall seen sparsely with a doorway and no lintel: the optimal α for one component bridges
+/// the 0.9 m doorway (with triangles across it); an α of at most 0.2 m keeps it open, as two
+/// polygons.
+#[test]
+fn a_limited_alpha_keeps_a_doorway_open() {
+    let points = jittered_grid((0.0, 3.0), (0.0, 2.5), 0.12, 11, |p| !(1.0..1.9).contains(&p.x));
+    let bridged = alpha_shape(&points, &AlphaShapeConfig::robust()).unwrap();
+    assert!(bridged.alpha > 0.4, "α = {}", bridged.alpha);
+    assert_eq!(bridged.polygons.len(), 1, "one polygon across the doorway");
+    let open = alpha_shape(&points, &AlphaShapeConfig::robust_at_most(0.2)).unwrap();
+    assert!(open.alpha <= 0.2 + 1e-12, "α = {}", open.alpha);
+    assert_eq!(open.polygons.len(), 2);
+    let area: Real = open.polygons.iter().map(Polygon::area).sum();
+    assert!((4.5..5.3).contains(&area), "two wall parts: {area} m²");
+    let bad = AlphaShapeConfig { max_alpha: Some(-1.0), ..AlphaShapeConfig::robust() };
+    assert!(matches!(alpha_shape(&points, &bad), Err(AlphaShapeError::InvalidAlpha { .. })));
 }
