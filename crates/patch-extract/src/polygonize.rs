@@ -12,7 +12,7 @@
 //! the region's fitted plane.
 
 use patch_core::triangulate::{TriangulationError, triangulate_polygon};
-use patch_core::{PatchError, PlanarPatch, Polygon, Real, Vector3};
+use patch_core::{PatchError, PlanarPatch, Polygon, Real};
 use pointcloud::PointCloud;
 
 use crate::PlanarRegion;
@@ -196,9 +196,7 @@ pub fn polygonize_region(
     let projected = project_region(cloud, region, &config.projection)?;
     let (polygons, alpha, num_components) = match &config.outline {
         OutlineMethod::AlphaShape(c) => {
-            let up = cloud.sensor_pose().map_or_else(Vector3::z, |pose| {
-                pose.world_from_sensor.rotation.inverse_transform_vector(&Vector3::z())
-            });
+            let up = crate::segment::up(cloud);
             let steep = region.plane.normal.dot(&up).abs() < std::f64::consts::FRAC_1_SQRT_2;
             let c = match config.wall_max_alpha {
                 Some(m) if steep => {

@@ -508,7 +508,7 @@ pub fn segment(cloud: &PointCloud, config: &SegmentConfig) -> Result<Segmentatio
 }
 
 /// The world's up (+z) in the sensor frame of `cloud` (+z without a pose).
-fn up(cloud: &PointCloud) -> Vector3 {
+pub(crate) fn up(cloud: &PointCloud) -> Vector3 {
     cloud.sensor_pose().map_or_else(Vector3::z, |pose| {
         let up = pose.world_from_sensor.rotation.inverse() * Vector3::z();
         if up.iter().all(|c| c.is_finite()) { up } else { Vector3::z() }
