@@ -100,8 +100,11 @@ pub struct SafetyRow {
     pub file_bytes: u64,
     /// Heap bytes of the map in its backend.
     pub memory_bytes: usize,
-    /// Extraction (or, for the pc map, point gathering) time per scan, seconds.
+    /// Extraction (or, for the pc maps, point gathering and cleaning) time per scan, seconds.
     pub seconds_per_scan: Real,
+    /// Loading the whole map into its backend (trimesh for patch maps, the point-cloud
+    /// backend for pc maps), seconds.
+    pub load_seconds: Real,
     /// Planner view: roadmap edges re-checked on the truth.
     pub edges: u64,
     /// Of those, edges that collide with the truth.
@@ -120,7 +123,7 @@ fn safety_row(
     truth: &AnyMap,
     map: &AnyMap,
     sampling: &StepSampling,
-    seconds_per_scan: Real,
+    (seconds_per_scan, load_seconds): (Real, Real),
 ) -> Result<SafetyRow> {
     let mut bytes = ByteCount(0);
     map.save(&mut bytes)?;
@@ -133,6 +136,7 @@ fn safety_row(
         file_bytes: bytes.0,
         memory_bytes: map.memory_bytes(),
         seconds_per_scan,
+        load_seconds,
         edges: 0,
         colliding_edges: 0,
         paths: 0,
@@ -184,21 +188,25 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                 let clouds = scan_clouds(&scene, &setup)?;
                 for &kind in &args.maps {
                     let started = Instant::now();
-                    let map = match extracted_patches(&clouds, kind)? {
-                        Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
-                        None => AnyMap::PointCloud(PointCloudMap::from_points(&pc_points(
-                            &clouds,
-                            &PcCleaning::default(),
-                        )?)?),
+                    let (patches, points) = match extracted_patches(&clouds, kind)? {
+                        Some(patches) => (Some(patches), Vec::new()),
+                        None => (None, pc_points(&clouds, &PcCleaning::default())?),
                     };
-                    let seconds_per_scan = started.elapsed().as_secs_f64() / scans.max(1) as Real;
+                    let extract_seconds = started.elapsed().as_secs_f64();
+                    let started = Instant::now();
+                    let map = match patches {
+                        Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
+                        None => AnyMap::PointCloud(PointCloudMap::from_points(&points)?),
+                    };
+                    let times =
+                        (extract_seconds / scans.max(1) as Real, started.elapsed().as_secs_f64());
                     let mut row = safety_row(
                         (name, noise, scans),
                         kind.name(),
                         &truth,
                         &map,
                         &sampling,
-                        seconds_per_scan,
+                        times,
                     )?;
                     if args.planner_iterations > 0 {
                         planner_view(&truth, &map, args, &mut row)?;
@@ -226,16 +234,20 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     for (label, mixed_pixels, denoise) in cleanings {
                         let started = Instant::now();
                         let points = pc_points(&clouds, &PcCleaning { mixed_pixels, denoise })?;
+                        let extract_seconds = started.elapsed().as_secs_f64();
+                        let started = Instant::now();
                         let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-                        let seconds_per_scan =
-                            started.elapsed().as_secs_f64() / scans.max(1) as Real;
+                        let times = (
+                            extract_seconds / scans.max(1) as Real,
+                            started.elapsed().as_secs_f64(),
+                        );
                         rows.push(safety_row(
                             (name, noise, scans),
                             label,
                             &truth,
                             &map,
                             &sampling,
-                            seconds_per_scan,
+                            times,
                         )?);
                     }
                     let clean = scan_clouds_without_phantoms(&scene, &setup, PHANTOM_TOLERANCE)?;
@@ -247,7 +259,7 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                         &truth,
                         &map,
                         &sampling,
-                        0.0,
+                        (0.0, 0.0),
                     )?);
                 }
                 spinner.finish_and_clear();
@@ -339,9 +351,9 @@ pub fn safety_table(rows: &[SafetyRow]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "| scene | noise | scans | map | unsafe % [95 %] | over- cautious % [95 %] | unsafe − floor | file bytes | memory bytes | s / scan | colliding edges % | colliding paths % |"
+        "| scene | noise | scans | map | unsafe % [95 %] | over- cautious % [95 %] | unsafe − floor | file bytes | memory bytes | extract s / scan | load s | colliding edges % | colliding paths % |"
     );
-    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(out, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         let floor = rows
             .iter()
@@ -353,7 +365,7 @@ pub fn safety_table(rows: &[SafetyRow]) -> String {
         let o = r.comparison.overcautious_rate();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {:.2} [{:.2}, {:.2}] | {:.2} [{:.2}, {:.2}] | {} | {} | {} | {:.3} | {} | {} |",
+            "| {} | {} | {} | {} | {:.2} [{:.2}, {:.2}] | {:.2} [{:.2}, {:.2}] | {} | {} | {} | {:.3} | {:.2} | {} | {} |",
             r.scene,
             r.noise,
             r.scans,
@@ -368,6 +380,7 @@ pub fn safety_table(rows: &[SafetyRow]) -> String {
             r.file_bytes,
             r.memory_bytes,
             r.seconds_per_scan,
+            r.load_seconds,
             pct(r.colliding_edges, r.edges),
             pct(r.colliding_paths, r.paths),
         );
