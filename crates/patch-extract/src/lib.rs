@@ -67,6 +67,6 @@ pub use mixed_pixels::{
 pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
-pub use segment::{GrazingPlanes, SegmentConfig, segment};
+pub use segment::{GrazingPlanes, SegmentConfig, segment, segment_remainder};
 pub use spherical_grid::{SphericalGrid, SphericalGridConfig};
 pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};

@@ -24,7 +24,7 @@ use crate::grid_mesh::RegionMask;
 use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
 use crate::polygonize::{PolygonizeConfig, polygonize_region};
-use crate::segment::{SegmentConfig, SegmentError, segment};
+use crate::segment::{SegmentConfig, SegmentError, segment, segment_remainder};
 use crate::slab::{SlabError, back_faces};
 use crate::spherical_grid::{SphericalGridConfig, SphericalGridError, mesh_unorganised};
 use crate::trimesh_grow::{GrownTrimeshes, TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
@@ -50,6 +50,10 @@ pub const ALRF_FILL_TILT: Real = std::f64::consts::FRAC_PI_6;
 pub struct PipelineConfig {
     /// Plane segmentation.
     pub segment: SegmentConfig,
+    /// A second segmentation of each organised scan's remainder, usually with smaller seed
+    /// windows and regions ([`crate::segment::segment_remainder`], not in the thesis); `None`:
+    /// one pass.
+    pub second_pass: Option<SegmentConfig>,
     /// Projection, outline and simplification of each region.
     pub polygonize: PolygonizeConfig,
     /// Trimesh growing on the remainder (hybrid maps, thesis §6.1); `None`: planes only.
@@ -80,7 +84,8 @@ pub struct PipelineConfig {
 }
 
 impl PipelineConfig {
-    /// For actuated-LRF scans (S300-like, 1–3 cm noise): [`SegmentConfig::alrf`],
+    /// For actuated-LRF scans (S300-like, 1–3 cm noise): [`SegmentConfig::alrf`], a second
+    /// pass over the remainder ([`SegmentConfig::alrf_second_pass`]),
     /// [`PolygonizeConfig::conservative`] (outlines grown to cover what the scan saw),
     /// merging with [`MergeConfig::alrf`], no remainder meshes, no mixed-pixel filter (on the
     /// lab it removes real obstacle points: planes map unsafe 2.8 → 3.7 %; see
@@ -89,6 +94,7 @@ impl PipelineConfig {
     pub fn alrf() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::alrf(),
+            second_pass: Some(SegmentConfig::alrf_second_pass()),
             polygonize: PolygonizeConfig::conservative(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
@@ -107,6 +113,7 @@ impl PipelineConfig {
     pub fn alrf_thesis() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig { grazing: None, ..SegmentConfig::alrf() },
+            second_pass: None,
             polygonize: PolygonizeConfig::thesis(),
             denoise: None,
             slab_thickness: None,
@@ -120,6 +127,7 @@ impl PipelineConfig {
     pub fn range_camera() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::range_camera(),
+            second_pass: None,
             polygonize: PolygonizeConfig::thesis(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
@@ -136,6 +144,7 @@ impl PipelineConfig {
     pub fn structured_light() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::structured_light(),
+            second_pass: None,
             polygonize: PolygonizeConfig::thesis(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
@@ -152,6 +161,7 @@ impl PipelineConfig {
     pub fn exact() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::exact(),
+            second_pass: None,
             polygonize: PolygonizeConfig::thesis(),
             remainder: None,
             merge: Some(MergeConfig::exact()),
@@ -240,6 +250,9 @@ pub struct ScanReport {
     pub regions: usize,
     /// Points in planar regions.
     pub region_points: usize,
+    /// Of the regions, those found by the second pass over the remainder
+    /// ([`PipelineConfig::second_pass`]).
+    pub second_pass_regions: usize,
     /// Planar patches made from the regions.
     pub planar_patches: usize,
     /// Regions that could not be polygonised.
@@ -350,8 +363,12 @@ pub fn extract(
             _ => scan,
         };
         let t = Instant::now();
-        let segmentation = segment(scan, &config.segment)
+        let mut segmentation = segment(scan, &config.segment)
             .map_err(|source| ExtractError::Segment { scan: index, source })?;
+        if let Some(second) = &config.second_pass {
+            report.second_pass_regions = segment_remainder(scan, &mut segmentation, second)
+                .map_err(|source| ExtractError::Segment { scan: index, source })?;
+        }
         out.times.segmentation += t.elapsed();
         report.regions = segmentation.regions.len();
         report.region_points = segmentation.regions.iter().map(|r| r.points.len()).sum();

@@ -4,7 +4,9 @@ use patch_core::{Plane, Point3, Real, UnitVector3, Vector3};
 use patch_extract::Segmentation;
 use patch_extract::evaluate::{SegCompConfig, SegCompReport, segcomp};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
-use patch_extract::segment::{SegmentConfig, SegmentError, segment, segment_unorganised};
+use patch_extract::segment::{
+    SegmentConfig, SegmentError, segment, segment_remainder, segment_unorganised,
+};
 use pointcloud::{BeamModel, PointCloud, SensorPose};
 use scene_sim::{
     Alrf, AlrfConfig, Cuboid, Material, PlanarPolygon, RangeCamera, RangeCameraConfig, RangeSensor,
@@ -447,4 +449,53 @@ fn structured_light_frames_keep_a_far_wall_whole_where_the_range_camera_preset_f
         light.regions.len(),
         largest_share(&light)
     );
+}
+
+/// An organised cloud seen from the origin at 1° per pixel: a wall at x = 3 m whose rows
+/// `band` alone show between two nearer boards (x = 1.5 m) that hide the rest of it above
+/// row 20.
+fn wall_band_behind_boards(band: std::ops::Range<u32>) -> PointCloud {
+    let (w, h) = (60u32, 60u32);
+    let pixels = (0..h).flat_map(move |row| {
+        let band = band.clone();
+        (0..w).map(move |col| {
+            let az = (Real::from(col) - 30.0).to_radians();
+            let el = (Real::from(row) - 30.0).to_radians();
+            let dir = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+            let x = if row < 20 || band.contains(&row) { 3.0 } else { 1.5 };
+            Some(Point3::from(dir * (x / dir.x)))
+        })
+    });
+    PointCloud::from_pixels(w, h, pixels).unwrap()
+}
+
+#[test]
+fn the_second_pass_finds_a_band_of_wall_too_narrow_for_the_first_pass_seeds() {
+    let cloud = wall_band_behind_boards(40..43);
+    let mut seg = segment(&cloud, &SegmentConfig::alrf()).unwrap();
+    let on_band = |i: &u32| (40 * 60..43 * 60).contains(i);
+    assert!(seg.regions.iter().all(|r| !r.points.iter().any(on_band)), "no 5×5 window fits");
+    let before = seg.regions.len();
+    let added = segment_remainder(&cloud, &mut seg, &SegmentConfig::alrf_second_pass()).unwrap();
+    assert_eq!(added, 1);
+    assert_eq!(seg.regions.len(), before + 1);
+    check_invariants(&cloud, &seg, 20);
+    let band = seg.regions.iter().find(|r| r.points.iter().any(on_band)).unwrap();
+    assert!(band.points.iter().all(on_band));
+    assert!(band.points.len() >= 150, "{}", band.points.len());
+    assert!(band.plane.normal.x.abs() > 0.999, "the wall's plane x = 3");
+    assert!((band.plane.signed_distance(&Point3::new(3.0, 0.0, 0.0))).abs() < 1e-6);
+    // Regions stay largest first, and the remainder lost the band.
+    assert!(seg.regions.windows(2).all(|p| p[0].points.len() >= p[1].points.len()));
+    assert!(seg.remainder.iter().filter(|i| on_band(i)).count() + band.points.len() == 180);
+}
+
+#[test]
+fn the_second_pass_leaves_an_unorganised_cloud_alone() {
+    let grid = wall_band_behind_boards(40..43);
+    let cloud = PointCloud::from_positions(grid.positions().to_vec()).unwrap();
+    let mut seg = segment(&cloud, &SegmentConfig::alrf()).unwrap();
+    let before = seg.clone();
+    assert_eq!(segment_remainder(&cloud, &mut seg, &SegmentConfig::alrf_second_pass()).unwrap(), 0);
+    assert_eq!(seg, before);
 }

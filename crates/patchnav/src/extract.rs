@@ -98,6 +98,10 @@ pub struct ExtractArgs {
     /// Keep every scan's patches instead of merging coplanar overlapping ones.
     #[arg(long)]
     pub no_merge: bool,
+    /// Segment each scan once, without the second pass over the points in no plane with
+    /// smaller seed windows and regions (on in the `alrf` preset; off in the others).
+    #[arg(long)]
+    pub no_second_pass: bool,
     /// Each planar patch gets a back face this many metres behind the side it was seen from,
     /// so that the map holds slabs (0: bare surfaces; default: the sensor preset's, 0.04 m
     /// for `alrf`, none for the others). The mesh export and the plane polygons hold the
@@ -128,6 +132,9 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
     }
     if args.no_merge {
         config.merge = None;
+    }
+    if args.no_second_pass {
+        config.second_pass = None;
     }
     if let Some(t) = args.slab_thickness {
         config.slab_thickness = (t != 0.0).then_some(t);
@@ -236,11 +243,12 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     for (path, r) in args.scans.iter().zip(&result.scans) {
         writeln!(
             out,
-            "{}: {} points, {} planes ({} points), {} planar patches, {} failed, \
-             {} remainder points, {} trimesh patches; outline vertices {} -> {}",
+            "{}: {} points, {} planes ({} of them from the second pass; {} points), {} planar \
+             patches, {} failed, {} remainder points, {} trimesh patches; outline vertices {} -> {}",
             path.display(),
             r.points,
             r.regions,
+            r.second_pass_regions,
             r.region_points,
             r.planar_patches,
             r.failed_regions,
@@ -477,6 +485,7 @@ mod tests {
             sensor: SensorPreset::RangeCamera,
             hybrid: false,
             no_merge: false,
+            no_second_pass: false,
             slab_thickness: None,
             poses: None,
             export: None,
