@@ -9,6 +9,7 @@
 //! | mixed pixels (veil points) at depth edges, before segmentation | [`mod@mixed_pixels`] | — (ours: the shadow/veil test of PCL and ROS with line and plane support, measured in the module) |
 //! | incremental least-squares plane fit | [`plane_fit`] | §5.3.2 (orthogonal LSQ, L4624–4628) |
 //! | region growing segmentation | [`mod@segment`] | Poppinga et al. 2008, undescribed in the thesis: our method is documented in the module |
+//! | a second pass over the remainder with smaller seed windows and regions | [`segment_remainder`] | — (ours) |
 //! | segmentation quality (SegComp, Hoover et al. 1996) | [`evaluate`] | — |
 //! | projection: early/late, orthogonal/along the beam; ALRF ±90° columns | [`projection`] | §5.3.2, App. A |
 //! | α-shapes with the optimal α for one component (ours: a robust α, an α limit) | [`alpha_shape`] | Alg 6, L4839–4909 |
