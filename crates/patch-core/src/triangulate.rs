@@ -4,9 +4,13 @@
 //!
 //! The rings' edges are inserted as constraints with spade's non-panicking
 //! `can_add_constraint`/`try_add_constraint`, so crossing rings give an error instead of a panic.
-//! A triangle of the triangulation is kept when its centroid lies inside the polygon (inside the
-//! outer ring and outside every hole, by the crossing rule): every triangle lies wholly inside or
-//! wholly outside, because the polygon's boundary consists of constraint edges.
+//! A triangle of the triangulation is kept when it lies inside the polygon: every triangle lies
+//! wholly inside or wholly outside, because the polygon's boundary consists of constraint
+//! edges, and a walk from the outer face to it crosses an odd number of them exactly when it
+//! is inside (inside the outer ring and outside every hole). The parity is found by a
+//! breadth-first walk over the triangles, without coordinate arithmetic: a sliver triangle
+//! between nearly collinear vertices, whose centroid rounding could put on either side, is
+//! classified exactly.
 
 use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
@@ -95,12 +99,11 @@ pub fn triangulate_polygon(rings: &[Vec<[f64; 2]>]) -> Result<Triangulated, Tria
     }
     let vertices: Vec<[f64; 2]> =
         cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+    let inside = inside_faces(&cdt);
     let mut triangles = Vec::new();
     for face in cdt.inner_faces() {
         let [a, b, c] = face.vertices();
-        let (pa, pb, pc) = (a.position(), b.position(), c.position());
-        let centroid = [(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0];
-        if inside(rings, centroid) {
+        if inside[face.fix().index()] {
             triangles.push([
                 a.fix().index() as u32,
                 b.fix().index() as u32,
@@ -111,22 +114,38 @@ pub fn triangulate_polygon(rings: &[Vec<[f64; 2]>]) -> Result<Triangulated, Tria
     Ok(Triangulated { vertices, triangles })
 }
 
-/// Crossing-number test over all rings: inside the outer ring and outside every hole.
-fn inside(rings: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
-    let mut odd = false;
-    for ring in rings {
-        let n = ring.len();
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if (a[1] > p[1]) != (b[1] > p[1]) {
-                let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-                if p[0] < x {
-                    odd = !odd;
+/// Per face of `cdt` (by index): whether it lies inside the polygon whose rings are its
+/// constraint edges, i.e. whether walks from the outer face to it cross an odd number of
+/// constraint edges (the parity is the same along every walk, the rings being closed).
+fn inside_faces(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<bool> {
+    let crossings = |e: spade::handles::DirectedEdgeHandle<'_, _, _, _, _>| {
+        u32::from(cdt.is_constraint_edge(e.as_undirected().fix()))
+    };
+    let mut depth: Vec<Option<u32>> = vec![None; cdt.num_all_faces()];
+    let mut queue = std::collections::VecDeque::new();
+    for face in cdt.inner_faces() {
+        for e in face.adjacent_edges() {
+            let slot = &mut depth[face.fix().index()];
+            if slot.is_none() && e.rev().face().is_outer() {
+                *slot = Some(crossings(e));
+                queue.push_back(face.fix());
+            }
+        }
+    }
+    while let Some(fixed) = queue.pop_front() {
+        let face = cdt.face(fixed);
+        let d = depth[fixed.index()].unwrap_or(0);
+        for e in face.adjacent_edges() {
+            if let Some(next) = e.rev().face().as_inner() {
+                let slot = &mut depth[next.fix().index()];
+                if slot.is_none() {
+                    *slot = Some(d + crossings(e));
+                    queue.push_back(next.fix());
                 }
             }
         }
     }
-    odd
+    depth.into_iter().map(|d| d.is_some_and(|d| d % 2 == 1)).collect()
 }
 
 /// The world triangles of a patch: a planar patch's polygon triangulated by
@@ -192,6 +211,48 @@ mod tests {
         let t = triangulate_polygon(&l).unwrap();
         let area: f64 = t.triangles.iter().map(|tr| tri_area(&t.vertices, tr)).sum();
         assert!((area - 3.0).abs() < 1e-12);
+    }
+
+    /// A patch outline from a lab scan with two vertices 1e-9 m apart on a nearly straight
+    /// edge: the sliver outside it, between them and the next vertex, has a centroid that
+    /// rounding put inside the ring. The walk over the triangles classifies it exactly.
+    #[test]
+    fn a_sliver_outside_a_nearly_straight_edge_is_not_kept() {
+        let ring = vec![
+            [-0.30394544619192254, 0.02893516701273442],
+            [-0.31121996211876046, 0.01958966255746604],
+            [-0.30956240817029845, 0.00786321610770942],
+            [-0.30261096338798177, -0.04131513460911988],
+            [-0.30010012983401191, -0.05907815414853572],
+            [-0.29288629795481336, -0.06534400861151694],
+            [-0.27494670151789558, -0.06534400954283952],
+            [-0.05990722942222726, -0.06534401513077497],
+            [-0.02054624053706300, -0.06534401699342011],
+            [-0.02054623960574042, -0.06534401699342011],
+            [0.34054160789529908, -0.06534402071871041],
+            [0.35848120433221686, -0.06534402071871041],
+            [0.37266946976016391, -0.02902428712137221],
+            [0.35948032439629662, -0.01686387694813489],
+            [0.35131616258005727, -0.00933650880493402],
+            [0.36304131262879002, 0.02127330843917848],
+            [0.36945842971037257, 0.03802591283432961],
+            [0.33553717491160262, 0.06444016192667008],
+            [0.32086784970889914, 0.05411349703185082],
+            [0.30578751974682439, 0.04349750001542092],
+            [0.29757144228498567, 0.05789001659117461],
+            [0.28072860670219291, 0.05732692406140090],
+            [0.19856507723162997, 0.05458001699857236],
+            [0.18621365838627446, 0.08708036598376752],
+            [0.16829099991302121, 0.08630097751132966],
+            [-0.26137126310785186, 0.06761658657900811],
+            [-0.27427264004071128, 0.06705555413476945],
+            [-0.28220473769177568, 0.05686525907926084],
+        ];
+        let t = triangulate_polygon(std::slice::from_ref(&ring)).unwrap();
+        assert_eq!(t.triangles.len(), ring.len() - 2);
+        assert!(t.triangles.iter().all(|tr| tri_area(&t.vertices, tr) > 0.0), "CCW");
+        let area: f64 = t.triangles.iter().map(|tr| tri_area(&t.vertices, tr)).sum();
+        assert!((area - ring_area(&ring).abs()).abs() < 1e-12, "{area}");
     }
 
     #[test]
