@@ -237,8 +237,7 @@ fn lab_maps(params: &LabMapParams) -> Result<PathBuf> {
         "commands": commands,
     });
     let path = dir.join("build.json");
-    std::fs::write(&path, format!("{manifest:#}\n"))
-        .with_context(|| format!("writing {}", path.display()))?;
+    pointcloud::io::write_bytes_atomically(&path, format!("{manifest:#}\n"))?;
     Ok(dir)
 }
 
@@ -300,7 +299,7 @@ pub fn run(args: &[String]) -> Result<()> {
         let mut keys: Vec<&String> = done.iter().collect();
         keys.sort();
         let text: String = keys.iter().map(|k| format!("{k}\n")).collect();
-        std::fs::write(&list, text).with_context(|| format!("writing {}", list.display()))?;
+        pointcloud::io::write_bytes_atomically(&list, text)?;
         println!(
             "resuming: {} cases of revision {revision} already in {}",
             done.len(),

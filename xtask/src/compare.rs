@@ -164,7 +164,7 @@ pub fn run(args: &[String]) -> Result<()> {
             row["provenance"] = provenance.clone();
             writeln!(text, "{row}")?;
         }
-        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        pointcloud::io::write_bytes_atomically(&path, text)?;
         println!("\n## {name}\n\n{table}\n(rows: {})", path.display());
         write!(summary, "\n## {name}\n\n{table}\n")?;
         Ok(())
@@ -191,7 +191,7 @@ pub fn run(args: &[String]) -> Result<()> {
         part("segmentation", rows, table)?;
     }
     let path = env.out.join("summary.md");
-    std::fs::write(&path, summary).with_context(|| format!("writing {}", path.display()))?;
+    pointcloud::io::write_bytes_atomically(&path, summary)?;
     println!("\nwrote {}", path.display());
     Ok(())
 }

@@ -107,7 +107,7 @@ pub fn write_all(dir: &Path) -> Result<Vec<&'static str>> {
     let mut names = Vec::new();
     for (name, bytes) in generate()? {
         let path = dir.join(name);
-        std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
+        pointcloud::io::write_bytes_atomically(&path, bytes)?;
         names.push(name);
     }
     Ok(names)

@@ -279,8 +279,7 @@ pub fn write_logs(rows: &[Value], dir: &Path) -> Result<Vec<PathBuf>> {
     exps.iter()
         .map(|e| {
             let path = dir.join(format!("{}.log", e.name));
-            std::fs::write(&path, format_log(e))
-                .with_context(|| format!("writing {}", path.display()))?;
+            pointcloud::io::write_bytes_atomically(&path, format_log(e))?;
             Ok(path)
         })
         .collect()

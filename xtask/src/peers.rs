@@ -282,7 +282,7 @@ pub fn run(args: &[String]) -> Result<()> {
         row["provenance"] = provenance.clone();
         writeln!(text, "{row}")?;
     }
-    std::fs::write(&args.out, text).with_context(|| format!("writing {}", args.out.display()))?;
+    pointcloud::io::write_bytes_atomically(&args.out, text)?;
     println!("{}", table(&rows, &truth));
     println!(
         "\nwrote {} ({} rows; polygons in {})",

@@ -201,7 +201,7 @@ pub fn run(args: &[String]) -> Result<()> {
     for r in &rows {
         text += &format!("{r}\n");
     }
-    std::fs::write(&out_path, text).with_context(|| format!("writing {}", out_path.display()))?;
+    pointcloud::io::write_bytes_atomically(&out_path, text)?;
     println!("{table}rows: {}", out_path.display());
     Ok(())
 }

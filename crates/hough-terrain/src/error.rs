@@ -61,9 +61,16 @@ pub enum HoughError {
     /// Writing the histogram image.
     #[error("writing PNG: {0}")]
     Png(String),
-    /// Opening the histogram file.
+    /// Writing the histogram file (the message names it).
     #[error(transparent)]
     Io(#[from] std::io::Error),
+}
+
+/// A failure of [`pointcloud::io::write_atomically`], as [`HoughError::Io`] naming the file.
+impl From<pointcloud::io::WriteError> for HoughError {
+    fn from(e: pointcloud::io::WriteError) -> HoughError {
+        HoughError::Io(e.into())
+    }
 }
 
 /// Shorthand for this crate's results.

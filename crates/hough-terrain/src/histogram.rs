@@ -114,14 +114,13 @@ pub fn hough_png<W: Write>(acc: &Accumulator, style: &HistogramStyle, writer: W)
     out.finish().map_err(|e| HoughError::Png(e.to_string()))
 }
 
-/// [`hough_png`] into a file at `path` (created or truncated).
+/// [`hough_png`] into a file at `path`, replaced whole ([`pointcloud::io::write_atomically`]).
 pub fn hough_png_file(
     acc: &Accumulator,
     style: &HistogramStyle,
     path: impl AsRef<Path>,
 ) -> Result<()> {
-    let file = std::fs::File::create(path)?;
-    hough_png(acc, style, std::io::BufWriter::new(file))
+    pointcloud::io::write_atomically(path, |w| hough_png(acc, style, w))
 }
 
 #[cfg(test)]

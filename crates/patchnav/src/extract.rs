@@ -450,8 +450,7 @@ fn write_polygons(path: &Path, map: &str, patches: &[Patch]) -> Result<()> {
         .collect();
     let doc =
         json!({"tool": tool_name(), "method": "region-growing", "map": map, "planes": planes});
-    std::fs::write(path, format!("{doc}\n"))
-        .with_context(|| format!("writing {}", path.display()))?;
+    pointcloud::io::write_bytes_atomically(path, format!("{doc}\n"))?;
     Ok(())
 }
 

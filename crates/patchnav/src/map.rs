@@ -34,7 +34,7 @@ use patch_map::{
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
 use std::fs::File;
-use std::io::{BufReader, BufWriter};
+use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 /// `patchnav map ...`.
@@ -269,9 +269,9 @@ pub fn open_map(path: &Path) -> Result<AnyMap> {
 }
 
 fn save<M: MapFile + MemoryUsage>(map: &M, out: &Path) -> Result<(u64, usize)> {
-    let file = File::create(out).with_context(|| format!("creating {}", out.display()))?;
-    let bytes =
-        map.save(BufWriter::new(file)).with_context(|| format!("writing {}", out.display()))?;
+    let bytes = io::write_atomically(out, |w| {
+        map.save(w).with_context(|| format!("writing {}", out.display()))
+    })?;
     Ok((bytes, map.memory_bytes()))
 }
 
@@ -460,7 +460,7 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
                 writeln!(csv, "{kind},{},{},{},{},{}", s.index, s.patch.0, p.x, p.y, p.z)?;
             }
         }
-        std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;
+        io::write_bytes_atomically(path, csv)?;
     }
     let misses = surfaces(&truth, c.unsafe_by_patch());
     let blocks = surfaces(&test, c.overcautious_by_patch());

@@ -270,5 +270,6 @@ pub(crate) fn write_obj_lines(
         let ids: Vec<String> = line.iter().map(|i| (i + 1).to_string()).collect();
         writeln!(text, "l {}", ids.join(" "))?;
     }
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    pointcloud::io::write_bytes_atomically(path, text)?;
+    Ok(())
 }

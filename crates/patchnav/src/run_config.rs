@@ -107,11 +107,9 @@ pub fn run(args: &RunArgs, progress: &Progress) -> Result<()> {
         .with_context(|| format!("output.dir: creating {}", config.out.display()))?;
     let (results, skipped) = pipeline::run(&config, progress)?;
     let json = config.out.join("results.json");
-    std::fs::write(&json, serde_json::to_string(&results)? + "\n")
-        .with_context(|| format!("writing {}", json.display()))?;
+    pointcloud::io::write_bytes_atomically(&json, serde_json::to_string(&results)? + "\n")?;
     let html = config.out.join("report.html");
-    crate::demo::report::write(&results, &html)
-        .with_context(|| format!("writing {}", html.display()))?;
+    crate::demo::report::write(&results, &html)?;
     progress.say(summary(&config, &results, &skipped)?.trim_end());
     progress.report(format!("report: {}", html.display()));
     Ok(())

@@ -12,16 +12,14 @@
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use pointcloud::io::Precision;
 use pointcloud::io::ply::{PlyEncoding, PlyWriteOptions, write_ply};
+use pointcloud::io::{Precision, write_atomically, write_bytes_atomically};
 use pointcloud::{FieldData, PointCloud, RangeImage, ScalarField, SensorPose};
 use scene_sim::{
     Alrf, AlrfConfig, RangeCamera, RangeSensor, Scene, SimulatedScan, StereoCamera, scene_by_name,
     scene_names,
 };
 use serde_json::json;
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// The sensors `simulate` offers.
@@ -173,10 +171,9 @@ fn truth_cloud(scan: &SimulatedScan) -> Result<PointCloud> {
 }
 
 fn write_cloud_ply(path: &Path, cloud: &PointCloud) -> Result<()> {
-    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let options =
         PlyWriteOptions { encoding: PlyEncoding::BinaryLittleEndian, precision: Precision::F32 };
-    write_ply(BufWriter::new(file), cloud, &options).map_err(|e| e.with_path(path))?;
+    write_atomically(path, |w| write_ply(w, cloud, &options)).map_err(|e| e.with_path(path))?;
     Ok(())
 }
 
@@ -220,5 +217,6 @@ fn scene_json(scene: &Scene, args: &SimulateArgs) -> serde_json::Value {
 
 fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
     let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text + "\n").with_context(|| format!("writing {}", path.display()))
+    write_bytes_atomically(path, text + "\n")?;
+    Ok(())
 }

@@ -114,13 +114,14 @@ pub fn run(args: &SimulateArgs, progress: &Progress) -> Result<()> {
 
 /// A 16-bit grayscale PNG (big-endian samples, as PNG stores them).
 fn write_u16_png(path: &std::path::Path, width: u32, height: u32, data: &[u16]) -> Result<()> {
-    let file = std::fs::File::create(path)?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
-    encoder.set_color(png::ColorType::Grayscale);
-    encoder.set_depth(png::BitDepth::Sixteen);
-    let mut writer = encoder.write_header()?;
-    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
-    writer.write_image_data(&bytes)?;
-    writer.finish()?;
-    Ok(())
+    pointcloud::io::write_atomically(path, |out| -> Result<()> {
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let mut writer = encoder.write_header()?;
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_be_bytes()).collect();
+        writer.write_image_data(&bytes)?;
+        writer.finish()?;
+        Ok(())
+    })
 }

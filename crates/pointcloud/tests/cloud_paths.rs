@@ -1,8 +1,10 @@
-//! Path-level reading and writing: format by extension, sidecar files, errors naming the path.
+//! Path-level reading and writing: format by extension, sidecar files, errors naming the path,
+//! and the atomic writer (a failed or killed write leaves the old file intact).
 
 use pointcloud::io::depth_png::{DepthCamera, write_depth_png};
 use pointcloud::io::{
-    ErrorKind, ReadOptions, depth_camera_for, read_cloud, read_mesh, read_range_image, write_cloud,
+    ErrorKind, Format, ReadOptions, WriteStep, depth_camera_for, read_cloud, read_mesh,
+    read_range_image, write_atomically, write_bytes_atomically, write_cloud,
 };
 use pointcloud::{
     BeamModel, PinholeIntrinsics, Point3, PointCloud, RangeImage, RangeKind, SensorPose,
@@ -150,4 +152,140 @@ fn obj_paths_read_meshes_and_vertices() {
     let m = read_mesh(&path).unwrap();
     assert_eq!((m.num_faces(), m.num_triangles()), (1, 2));
     assert_eq!(read_cloud(&path, &ReadOptions::STRICT).unwrap().len(), 4);
+}
+
+/// What a replaced file held before.
+const OLD: &[u8] = b"the user's map, which must survive\n";
+
+/// New content, larger than any write buffer, so half of it reaches the disk before the crash.
+fn new_content() -> Vec<u8> {
+    (0..200_000u32).map(|i| (i % 251) as u8).collect()
+}
+
+/// The names in `dir` other than `keep`.
+fn others(dir: &Path, keep: &str) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != keep)
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn an_atomic_write_replaces_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.pmap");
+    // A new file.
+    let n = write_atomically(&path, |w| w.write_all(OLD).map(|()| OLD.len())).unwrap();
+    assert_eq!((n, std::fs::read(&path).unwrap()), (OLD.len(), OLD.to_vec()));
+    // Replacing it, shorter and longer.
+    write_bytes_atomically(&path, b"short").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"short");
+    let new = new_content();
+    write_bytes_atomically(&path, &new).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), new);
+    assert_eq!(others(dir.path(), "map.pmap"), Vec::<String>::new());
+    #[cfg(unix)]
+    {
+        // The replaced file keeps its mode; a symbolic link is followed, not replaced.
+        use std::os::unix::fs::PermissionsExt as _;
+        let mode = std::fs::Permissions::from_mode(0o640);
+        std::fs::set_permissions(&path, mode).unwrap();
+        write_bytes_atomically(&path, OLD).unwrap();
+        let meta = std::fs::metadata(&path).unwrap();
+        assert_eq!(meta.permissions().mode() & 0o777, 0o640);
+        let link = dir.path().join("link.pmap");
+        std::os::unix::fs::symlink(&path, &link).unwrap();
+        write_bytes_atomically(&link, b"through the link").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&path).unwrap(), b"through the link");
+    }
+}
+
+#[test]
+fn a_failed_atomic_write_leaves_the_old_file_and_no_temporary_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.pmap");
+    std::fs::write(&path, OLD).unwrap();
+    let new = new_content();
+    let e = write_atomically(&path, |w| {
+        w.write_all(&new[..new.len() / 2])?;
+        w.flush()?;
+        Err::<(), _>(std::io::Error::other("stopped half-way"))
+    })
+    .unwrap_err();
+    // The closure's own error comes back as it was.
+    assert_eq!(e.to_string(), "stopped half-way");
+    assert_eq!(std::fs::read(&path).unwrap(), OLD);
+    assert_eq!(others(dir.path(), "map.pmap"), Vec::<String>::new());
+
+    // A format error half-way through a cloud leaves the old cloud file too.
+    let ply = dir.path().join("cloud.ply");
+    write_cloud(&ply, &cloud()).unwrap();
+    let before = std::fs::read(&ply).unwrap();
+    let e = write_atomically(&ply, |w| {
+        let ply_error = |kind: ErrorKind| pointcloud::io::Error::new(Format::Ply, kind);
+        w.write_all(&before[..before.len() / 2]).map_err(|e| ply_error(e.into()))?;
+        Err::<(), _>(ply_error(ErrorKind::BadValue("no more".into())))
+    })
+    .unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::BadValue(_)), "{e}");
+    assert_eq!(std::fs::read(&ply).unwrap(), before);
+    assert_eq!(others(dir.path(), "cloud.ply"), vec!["map.pmap".to_owned()]);
+}
+
+#[test]
+fn the_writer_s_own_errors_name_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("no such folder").join("map.pmap");
+    let e = write_bytes_atomically(&path, OLD).unwrap_err();
+    assert_eq!((e.path.as_path(), e.step), (path.as_path(), WriteStep::CreateTemp));
+    assert!(e.to_string().contains("no such folder"), "{e}");
+    let io: std::io::Error = e.into();
+    assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+    assert!(io.to_string().contains("map.pmap"), "{io}");
+    let e = write_cloud(&path.with_extension("ply"), &cloud()).unwrap_err();
+    assert_eq!(e.path.as_deref(), Some(path.with_extension("ply").as_path()));
+    assert_eq!(e.format, Some(Format::Ply));
+    assert!(matches!(e.kind, ErrorKind::Io(_)));
+}
+
+/// Set in the child process of [`a_write_killed_mid_file_leaves_the_old_file`]: the file it
+/// writes and then dies writing.
+const KILLED_WRITE: &str = "POINTCLOUD_TEST_KILLED_WRITE";
+
+#[test]
+fn a_write_killed_mid_file_leaves_the_old_file() {
+    let new = new_content();
+    if let Some(target) = std::env::var_os(KILLED_WRITE) {
+        // The child: half of the new content reaches the temporary file, then the process dies.
+        let _ = write_atomically(&target, |w| -> std::io::Result<()> {
+            w.write_all(&new[..new.len() / 2])?;
+            w.flush()?;
+            std::process::abort()
+        });
+        unreachable!("the child writer returned instead of dying");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.pmap");
+    std::fs::write(&path, OLD).unwrap();
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", "a_write_killed_mid_file_leaves_the_old_file", "--nocapture"])
+        .env(KILLED_WRITE, &path)
+        .output()
+        .unwrap();
+    assert!(!out.status.success(), "the child did not die: {out:?}");
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::ExitStatusExt as _;
+        assert_eq!(out.status.signal(), Some(6), "not SIGABRT: {out:?}");
+    }
+    assert_eq!(std::fs::read(&path).unwrap(), OLD);
+    // The crash left its temporary file, recognisable by name, holding the half it wrote.
+    let left = others(dir.path(), "map.pmap");
+    assert_eq!(left.len(), 1, "{left:?}");
+    assert!(left[0].starts_with(".map.pmap.tmp"), "{left:?}");
+    assert_eq!(std::fs::read(dir.path().join(&left[0])).unwrap(), new[..new.len() / 2]);
 }

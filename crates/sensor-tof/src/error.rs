@@ -44,3 +44,10 @@ pub enum TofError {
     #[error(transparent)]
     Scene(#[from] scene_sim::SceneError),
 }
+
+/// A failure of [`pointcloud::io::write_atomically`], as [`TofError::Io`] naming the file.
+impl From<pointcloud::io::WriteError> for TofError {
+    fn from(e: pointcloud::io::WriteError) -> TofError {
+        TofError::Io(e.into())
+    }
+}

@@ -446,7 +446,7 @@ pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, TofEr
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), TofError> {
     let json_err = |why: String| TofError::Json { path: path.display().to_string(), why };
     let text = serde_json::to_string_pretty(value).map_err(|e| json_err(e.to_string()))?;
-    std::fs::write(path, text + "\n").map_err(|e| json_err(e.to_string()))
+    pointcloud::io::write_bytes_atomically(path, text + "\n").map_err(|e| json_err(e.to_string()))
 }
 
 /// Parses sidecar text: an ifm O3R `frame_meta.json` (recognised by its
@@ -639,13 +639,14 @@ pub(crate) fn encode(
         png::EncodingError::IoError(io) => file_error(path, io),
         other => file_error(path, ErrorKind::BadValue(other.to_string())),
     };
-    let file = std::fs::File::create(path).map_err(|e| file_error(path, e))?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
-    encoder.set_color(color);
-    encoder.set_depth(depth);
-    let mut w = encoder.write_header().map_err(png_err)?;
-    w.write_image_data(bytes).map_err(png_err)?;
-    w.finish().map_err(png_err)
+    pointcloud::io::write_atomically(path, |out| {
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(color);
+        encoder.set_depth(depth);
+        let mut w = encoder.write_header().map_err(png_err)?;
+        w.write_image_data(bytes).map_err(png_err)?;
+        w.finish().map_err(png_err)
+    })
 }
 
 /// Writes an 8-bit RGB PNG (`rgb` holds 3 bytes per pixel, row-major).

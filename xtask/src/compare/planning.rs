@@ -113,7 +113,7 @@ fn write_problem(env: &Env, name: &str, mode: &str, seeds: u64) -> Result<PathBu
     let dir = env.out.join("problems");
     std::fs::create_dir_all(&dir)?;
     let path = dir.join(format!("{name}-{mode}.json"));
-    std::fs::write(&path, serde_json::to_string_pretty(&v)?)?;
+    pointcloud::io::write_bytes_atomically(&path, serde_json::to_string_pretty(&v)?)?;
     Ok(path)
 }
 

@@ -303,10 +303,9 @@ fn lab_inputs(frames: usize, dir: &Path) -> Result<(truth::SceneTruth, Vec<Input
         let seed = scene_sim::sensors::derive_seed(LAB_SEED, i as u64);
         let cloud = camera.scan(&scene, pose, seed).to_cloud().context("building a lab frame")?;
         let path = dir.join(format!("frame{i:03}.ply"));
-        let file =
-            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?;
-        write_ply(std::io::BufWriter::new(file), &cloud, &options)
-            .with_context(|| format!("writing {}", path.display()))?;
+        pointcloud::io::write_atomically(&path, |w| {
+            write_ply(w, &cloud, &options).with_context(|| format!("writing {}", path.display()))
+        })?;
         labels.push(cloud.labels().context("a simulated frame without labels")?.to_vec());
         inputs.push(path);
     }

@@ -298,10 +298,8 @@ pub fn run(args: &[String]) -> Result<()> {
     let img = dir.join("img");
     std::fs::create_dir_all(&img).with_context(|| format!("creating {}", img.display()))?;
     let svg = img.join("benchmarks-office-time.svg");
-    std::fs::write(&svg, office_time_svg(&m))
-        .with_context(|| format!("writing {}", svg.display()))?;
-    std::fs::write(&out, page(&m, "img/benchmarks-office-time.svg")?)
-        .with_context(|| format!("writing {}", out.display()))?;
+    pointcloud::io::write_bytes_atomically(&svg, office_time_svg(&m))?;
+    pointcloud::io::write_bytes_atomically(&out, page(&m, "img/benchmarks-office-time.svg")?)?;
     println!("wrote {} and {} from {} rows", out.display(), svg.display(), m.rows);
     Ok(())
 }

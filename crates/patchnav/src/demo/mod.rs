@@ -48,10 +48,9 @@ pub fn run(args: &DemoArgs, progress: &Progress) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let results = pipeline::run(args.scale(), args.seed, &args.out, progress)?;
     let json = args.out.join("results.json");
-    std::fs::write(&json, serde_json::to_string(&results)? + "\n")
-        .with_context(|| format!("writing {}", json.display()))?;
+    pointcloud::io::write_bytes_atomically(&json, serde_json::to_string(&results)? + "\n")?;
     let html = args.out.join("report.html");
-    report::write(&results, &html).with_context(|| format!("writing {}", html.display()))?;
+    report::write(&results, &html)?;
     progress.report(format!("report: {}", html.display()));
     Ok(())
 }

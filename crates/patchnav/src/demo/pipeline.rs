@@ -185,10 +185,11 @@ pub(crate) fn p3mm(p: &Point3) -> [f64; 3] {
 /// Writes `cloud` as binary PLY with 32-bit float positions (a quarter of a millimetre at
 /// 1 km; half the size of doubles).
 pub(crate) fn write_ply_f32(path: &Path, cloud: &pointcloud::PointCloud) -> Result<()> {
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    pointcloud::io::ply::write_ply(file, cloud, &pointcloud::io::ply::PlyWriteOptions::default())
-        .with_context(|| format!("writing {}", path.display()))
+    let options = pointcloud::io::ply::PlyWriteOptions::default();
+    pointcloud::io::write_atomically(path, |w| {
+        pointcloud::io::ply::write_ply(w, cloud, &options)
+            .with_context(|| format!("writing {}", path.display()))
+    })
 }
 
 /// Writes a triangle mesh as binary little-endian PLY with 32-bit float vertices (what viewers
@@ -198,30 +199,29 @@ pub(crate) fn write_mesh_f32(
     vertices: &[Point3],
     triangles: &[[u32; 3]],
 ) -> Result<()> {
-    use std::io::Write as _;
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = std::io::BufWriter::new(file);
-    write!(
-        w,
-        "ply\nformat binary_little_endian 1.0\ncomment written by patchnav demo\n\
-         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
-         element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
-        vertices.len(),
-        triangles.len()
-    )?;
-    for p in vertices {
-        for c in [p.x, p.y, p.z] {
-            w.write_all(&(c as f32).to_le_bytes())?;
+    pointcloud::io::write_atomically(path, |w| -> std::io::Result<()> {
+        write!(
+            w,
+            "ply\nformat binary_little_endian 1.0\ncomment written by patchnav demo\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+            vertices.len(),
+            triangles.len()
+        )?;
+        for p in vertices {
+            for c in [p.x, p.y, p.z] {
+                w.write_all(&(c as f32).to_le_bytes())?;
+            }
         }
-    }
-    for t in triangles {
-        w.write_all(&[3])?;
-        for &i in t {
-            w.write_all(&i.to_le_bytes())?;
+        for t in triangles {
+            w.write_all(&[3])?;
+            for &i in t {
+                w.write_all(&i.to_le_bytes())?;
+            }
         }
-    }
-    w.flush().with_context(|| format!("writing {}", path.display()))
+        Ok(())
+    })
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 /// At most `max` of `items`, evenly spread (every ⌈n / max⌉-th).

@@ -51,9 +51,9 @@ ul.legend{list-style:none;padding:0;display:flex;flex-wrap:wrap;gap:.4em 1.4em;f
 .sw{display:inline-block;width:1.1em;height:1.1em;vertical-align:-.2em;margin-right:.35em;border:1px solid #888}\
 nav ol{columns:3;font-size:.9em}";
 
-/// Writes `report.html` for `results` to `path`.
+/// Writes `report.html` for `results` to `path`; errors name the file.
 pub fn write(results: &DemoResults, path: &Path) -> Result<()> {
-    std::fs::write(path, render(results))?;
+    pointcloud::io::write_bytes_atomically(path, render(results))?;
     Ok(())
 }
 

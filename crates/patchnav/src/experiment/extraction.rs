@@ -93,7 +93,6 @@ use scene_sim::{
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -342,13 +341,12 @@ pub fn run(args: &ExtractionArgs, progress: &Progress) -> Result<()> {
     writeln!(out, "\nTotal time: {:.1} s", started.elapsed().as_secs_f64())?;
     progress.report(out.trim_end());
     if let Some(path) = &args.jsonl {
-        let mut f = std::io::BufWriter::new(
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
-        );
-        for row in &rows {
-            writeln!(f, "{row}")?;
-        }
-        f.flush()?;
+        pointcloud::io::write_atomically(path, |f| -> Result<()> {
+            for row in &rows {
+                writeln!(f, "{row}")?;
+            }
+            Ok(())
+        })?;
     }
     Ok(())
 }

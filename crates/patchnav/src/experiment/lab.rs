@@ -451,11 +451,9 @@ pub fn run_timing(args: &LabTimingArgs, progress: &Progress) -> Result<()> {
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let csv = dir.join("lab-timing.csv");
-        std::fs::write(&csv, timing_csv(&runs, &cps))
-            .with_context(|| format!("writing {}", csv.display()))?;
+        pointcloud::io::write_bytes_atomically(&csv, timing_csv(&runs, &cps))?;
         let svg = dir.join("lab-timing.svg");
-        std::fs::write(&svg, timing_svg(&runs, &cps, &kinds, a))
-            .with_context(|| format!("writing {}", svg.display()))?;
+        pointcloud::io::write_bytes_atomically(&svg, timing_svg(&runs, &cps, &kinds, a))?;
         progress.say(format!("wrote {} and {}", csv.display(), svg.display()));
     }
     progress.report(timing_table(&runs, &cps, &kinds, a, args.seeds * lab.starts.len() as u64)?);

@@ -149,8 +149,7 @@ pub fn run(args: &MapSafetyArgs, progress: &Progress) -> Result<()> {
     let rows = safety_rows(args, progress)?;
     print!("{}", safety_table(&rows));
     if let Some(path) = &args.json {
-        std::fs::write(path, serde_json::to_string_pretty(&rows)?)
-            .with_context(|| format!("writing {}", path.display()))?;
+        pointcloud::io::write_bytes_atomically(path, serde_json::to_string_pretty(&rows)?)?;
     }
     Ok(())
 }

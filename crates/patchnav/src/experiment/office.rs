@@ -492,79 +492,79 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
         .iter()
         .filter(|b| args.backends.is_empty() || args.backends.contains(&b.0))
         .collect();
-    let mut jsonl = match &args.jsonl {
-        Some(path) => Some(std::io::BufWriter::new(
-            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
-        )),
-        None => None,
-    };
     let started = Instant::now();
-    let mut cells: Vec<Vec<Cell>> = planners.iter().map(|_| Vec::new()).collect();
-    let bar = progress.bar((planners.len() * backends.len()) as u64 * args.seeds, "runs");
-    for &&(backend, name, _) in &backends {
-        let map = map_from_patches(&p, patches.clone(), backend, args.sample_spacing)
-            .with_context(|| format!("building the `{name}` map"))?;
-        for (i, row) in planners.iter().enumerate() {
-            let mut runs = Vec::new();
-            let mut cannot = None;
-            for seed in 0..args.seeds {
-                bar.inc(1);
-                let mut planner = match make_planner(row.choice, &map, space, seed) {
-                    Ok(planner) => planner,
-                    Err(reason) => {
-                        if let Some(out) = &mut jsonl {
-                            let line = skipped_row(
-                                &p,
-                                row.choice,
-                                map.backend(),
-                                Mode::Roi,
-                                seed,
-                                &reason,
-                            );
-                            writeln!(out, "{line}")?;
+    // Every cell; with `jsonl`, one JSON line per run written to it as the runs go.
+    let run_cells = |mut jsonl: Option<&mut dyn std::io::Write>| -> Result<Vec<Vec<Cell>>> {
+        let mut cells: Vec<Vec<Cell>> = planners.iter().map(|_| Vec::new()).collect();
+        let bar = progress.bar((planners.len() * backends.len()) as u64 * args.seeds, "runs");
+        for &&(backend, name, _) in &backends {
+            let map = map_from_patches(&p, patches.clone(), backend, args.sample_spacing)
+                .with_context(|| format!("building the `{name}` map"))?;
+            for (i, row) in planners.iter().enumerate() {
+                let mut runs = Vec::new();
+                let mut cannot = None;
+                for seed in 0..args.seeds {
+                    bar.inc(1);
+                    let mut planner = match make_planner(row.choice, &map, space, seed) {
+                        Ok(planner) => planner,
+                        Err(reason) => {
+                            if let Some(out) = &mut jsonl {
+                                let line = skipped_row(
+                                    &p,
+                                    row.choice,
+                                    map.backend(),
+                                    Mode::Roi,
+                                    seed,
+                                    &reason,
+                                );
+                                writeln!(out, "{line}")?;
+                            }
+                            cannot = Some(format!("{reason:#}"));
+                            continue;
                         }
-                        cannot = Some(format!("{reason:#}"));
-                        continue;
+                    };
+                    let outcome =
+                        solve_timed(planner.as_mut(), &query, Mode::Roi, args.max_iterations);
+                    let paths: Vec<Option<Vec<Point3>>> =
+                        (0..p.goals.len()).map(|g| planner.path_to(g)).collect();
+                    let all: Option<Vec<Vec<Point3>>> = paths.iter().cloned().collect();
+                    let metrics = all.map(|paths| RunMetrics::of(outcome.1, &paths));
+                    if let Some(out) = &mut jsonl {
+                        let mut line = run_row(
+                            &p,
+                            planner.as_ref() as &dyn Planner,
+                            map.backend(),
+                            Mode::Roi,
+                            seed,
+                            outcome,
+                            &paths,
+                        );
+                        line["experiment"] = json!("office");
+                        line["iteration_cap"] = json!(args.max_iterations);
+                        if let Some(m) = metrics {
+                            line["added_length"] = json!(m.length);
+                            line["steep_turns"] = json!(m.steep as u64);
+                            line["turns"] = json!(m.turns as u64);
+                            line["steep_ratio"] = json!(steep_ratio(m.steep, m.turns));
+                            line["curviness_deg"] = json!(m.curviness_deg);
+                        }
+                        writeln!(out, "{line}")?;
                     }
-                };
-                let outcome = solve_timed(planner.as_mut(), &query, Mode::Roi, args.max_iterations);
-                let paths: Vec<Option<Vec<Point3>>> =
-                    (0..p.goals.len()).map(|g| planner.path_to(g)).collect();
-                let all: Option<Vec<Vec<Point3>>> = paths.iter().cloned().collect();
-                let metrics = all.map(|paths| RunMetrics::of(outcome.1, &paths));
-                if let Some(out) = &mut jsonl {
-                    let mut line = run_row(
-                        &p,
-                        planner.as_ref() as &dyn Planner,
-                        map.backend(),
-                        Mode::Roi,
-                        seed,
-                        outcome,
-                        &paths,
-                    );
-                    line["experiment"] = json!("office");
-                    line["iteration_cap"] = json!(args.max_iterations);
-                    if let Some(m) = metrics {
-                        line["added_length"] = json!(m.length);
-                        line["steep_turns"] = json!(m.steep as u64);
-                        line["turns"] = json!(m.turns as u64);
-                        line["steep_ratio"] = json!(steep_ratio(m.steep, m.turns));
-                        line["curviness_deg"] = json!(m.curviness_deg);
-                    }
-                    writeln!(out, "{line}")?;
+                    runs.push(metrics);
                 }
-                runs.push(metrics);
+                cells[i].push(match cannot {
+                    Some(reason) if runs.is_empty() => Cell::Cannot(reason),
+                    _ => Cell::Ran(runs),
+                });
             }
-            cells[i].push(match cannot {
-                Some(reason) if runs.is_empty() => Cell::Cannot(reason),
-                _ => Cell::Ran(runs),
-            });
         }
-    }
-    bar.finish_and_clear();
-    if let Some(mut out) = jsonl {
-        out.flush()?;
-    }
+        bar.finish_and_clear();
+        Ok(cells)
+    };
+    let cells = match &args.jsonl {
+        Some(path) => pointcloud::io::write_atomically(path, |w| run_cells(Some(w)))?,
+        None => run_cells(None)?,
+    };
     let elapsed = started.elapsed().as_secs_f64();
     let results = Results { planners, backends, cells };
     let mut out = String::new();

@@ -79,8 +79,7 @@ pub fn run(args: &TofArgs, progress: &Progress) -> Result<()> {
     }
     if let Some(path) = &args.json {
         let value = serde_json::json!({ "scenes": results, "folded": folded });
-        std::fs::write(path, serde_json::to_string_pretty(&value)? + "\n")
-            .with_context(|| format!("writing {}", path.display()))?;
+        pointcloud::io::write_bytes_atomically(path, serde_json::to_string_pretty(&value)? + "\n")?;
     }
     Ok(())
 }

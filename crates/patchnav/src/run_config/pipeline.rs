@@ -562,7 +562,7 @@ fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
         &mut png,
     )?;
     let name = "terrain-hough.png";
-    std::fs::write(files.path(name), &png).with_context(|| format!("writing {name}"))?;
+    pointcloud::io::write_bytes_atomically(files.path(name), &png)?;
     files.add("terrain Hough space (thesis Fig 4.3 layout)", name)?;
     let class = |x: hough_terrain::TerrainClass| format!("{x:?}").to_lowercase();
     let plane =

@@ -16,11 +16,16 @@
 //! against the bytes that are there before memory is reserved).
 //!
 //! [`read_cloud`] and [`write_cloud`] pick the format from the file extension.
+//!
+//! Every file is written through [`write_atomically`] (or [`write_bytes_atomically`]): into a
+//! temporary file beside the target, synced, then renamed over it, so an interrupted or failed
+//! write leaves the old file intact. The workspace's programs write their outputs through it too.
 
 use crate::AttributeError;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+mod atomic;
 pub mod depth_png;
 pub mod kitti;
 pub(crate) mod lzf;
@@ -29,6 +34,8 @@ pub mod pcd;
 pub mod ply;
 pub mod uos;
 pub mod xyz;
+
+pub use atomic::{WriteError, WriteStep, write_atomically, write_bytes_atomically};
 
 /// The file formats this crate reads and writes.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
@@ -195,6 +202,14 @@ impl fmt::Display for Error {
             write!(f, ", {pos}")?;
         }
         write!(f, ": {}", self.kind)
+    }
+}
+
+/// A failure of [`write_atomically`] itself, as an [`ErrorKind::Io`] naming the file.
+impl From<WriteError> for Error {
+    fn from(e: WriteError) -> Error {
+        let io = std::io::Error::new(e.error.kind(), format!("{}: {}", e.step, e.error));
+        Error { format: None, path: Some(e.path), position: None, kind: ErrorKind::Io(io) }
     }
 }
 
@@ -400,39 +415,36 @@ fn find_depth_camera(path: &Path) -> Result<(depth_png::DepthCamera, Option<Side
 /// [`crate::RangeImage`] with [`depth_png::write_depth_png`]. Every error names `path`.
 pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> {
     let format = format_of(path)?;
-    let create = || {
-        std::fs::File::create(path)
-            .map(std::io::BufWriter::new)
-            .map_err(|e| Error::new(format, e).with_path(path))
-    };
-    let result = match format {
+    let named = naming(format, path);
+    match format {
         Format::Ply => {
             let o = ply::PlyWriteOptions {
                 encoding: ply::PlyEncoding::BinaryLittleEndian,
                 precision: Precision::F64,
             };
-            ply::write_ply(create()?, cloud, &o)
+            write_atomically(path, |w| ply::write_ply(w, cloud, &o))
         }
         Format::Pcd => {
             let o = pcd::PcdWriteOptions {
                 encoding: pcd::PcdEncoding::BinaryCompressed,
                 precision: Precision::F32,
             };
-            pcd::write_pcd(create()?, cloud, &o)
+            write_atomically(path, |w| pcd::write_pcd(w, cloud, &o))
         }
-        Format::Obj => crate::PolygonMesh::new(cloud.positions().to_vec(), Vec::new())
-            .map_err(|e| Error::new(format, ErrorKind::BadValue(e.to_string())))
-            .and_then(|mesh| obj::write_obj(create()?, &mesh)),
-        Format::Xyz => xyz::write_xyz(create()?, cloud),
-        Format::KittiBin => kitti::write_kitti_bin(create()?, cloud),
+        Format::Obj => {
+            let mesh = crate::PolygonMesh::new(cloud.positions().to_vec(), Vec::new())
+                .map_err(|e| Error::new(format, ErrorKind::BadValue(e.to_string())))
+                .map_err(named)?;
+            write_atomically(path, |w| obj::write_obj(w, &mesh))
+        }
+        Format::Xyz => write_atomically(path, |w| xyz::write_xyz(w, cloud)),
+        Format::KittiBin => write_atomically(path, |w| kitti::write_kitti_bin(w, cloud)),
         Format::Uos => {
-            uos::write_uos_scan(create()?, cloud).map_err(|e| e.with_path(path))?;
+            write_atomically(path, |w| uos::write_uos_scan(w, cloud)).map_err(named)?;
             let pose_path = path.with_extension("pose");
             let pose = cloud.sensor_pose().copied().unwrap_or_else(crate::SensorPose::identity);
-            let file = std::fs::File::create(&pose_path)
-                .map_err(|e| Error::new(format, e).with_path(&pose_path))?;
-            return uos::write_uos_pose(std::io::BufWriter::new(file), &pose)
-                .map_err(|e| e.with_path(&pose_path));
+            return write_atomically(&pose_path, |w| uos::write_uos_pose(w, &pose))
+                .map_err(naming(format, &pose_path));
         }
         Format::DepthPng => Err(Error::new(
             format,
@@ -442,8 +454,8 @@ pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> 
                     .into(),
             ),
         )),
-    };
-    result.map_err(|e| e.with_path(path))
+    }
+    .map_err(named)
 }
 
 /// Writes `mesh` to `path` as OBJ ([`obj::write_obj`]) or, for a `.ply` path, as a binary PLY
@@ -451,13 +463,16 @@ pub fn write_cloud(path: &Path, cloud: &crate::PointCloud) -> Result<(), Error> 
 pub fn write_mesh(path: &Path, mesh: &crate::PolygonMesh) -> Result<(), Error> {
     let format =
         if Format::from_path(path) == Some(Format::Ply) { Format::Ply } else { Format::Obj };
-    let file = std::fs::File::create(path).map_err(|e| Error::new(format, e).with_path(path))?;
-    let writer = std::io::BufWriter::new(file);
-    match format {
-        Format::Ply => ply::write_ply_mesh(writer, mesh),
-        _ => obj::write_obj(writer, mesh),
-    }
-    .map_err(|e| e.with_path(path))
+    write_atomically(path, |w| match format {
+        Format::Ply => ply::write_ply_mesh(w, mesh),
+        _ => obj::write_obj(w, mesh),
+    })
+    .map_err(naming(format, path))
+}
+
+/// Names `path` in an error, and `format` when the error names none (the writer's own).
+fn naming(format: Format, path: &Path) -> impl Fn(Error) -> Error + Copy + '_ {
+    move |e| Error { format: e.format.or(Some(format)), ..e }.with_path(path)
 }
 
 /// The format of `path`, or an [`ErrorKind::Unsupported`] error naming the extension.

@@ -121,7 +121,7 @@ pub(super) fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
     pointcloud::io::write_cloud(&files.path(name), &cloud)?;
     files.add("terrain snapshot, SR-3000 frame (optical frame, with its pose)", name)?;
     let name = "terrain-hough.png";
-    std::fs::write(files.path(name), &png).with_context(|| format!("writing {name}"))?;
+    pointcloud::io::write_bytes_atomically(files.path(name), &png)?;
     files.add("terrain Hough space (thesis Fig 4.3 layout)", name)?;
     let p = result.plane.context("the terrain frame gave no votes")?;
     let plane = [p.rho_x.to_degrees(), p.rho_y.to_degrees(), p.d];
