@@ -217,6 +217,7 @@ mod tests {
     /// edge: the sliver outside it, between them and the next vertex, has a centroid that
     /// rounding put inside the ring. The walk over the triangles classifies it exactly.
     #[test]
+    #[allow(clippy::excessive_precision)] // the outline's coordinates as the map holds them
     fn a_sliver_outside_a_nearly_straight_edge_is_not_kept() {
         let ring = vec![
             [-0.30394544619192254, 0.02893516701273442],
