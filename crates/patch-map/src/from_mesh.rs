@@ -18,13 +18,22 @@
 //!
 //! The union moves vertices by at most the float overlay's snapping (about 1e-9 of the
 //! cluster's extent); no area is lost or added beyond that.
+//!
+//! [`map_from_obj`] does all of it for an OBJ file and builds a map of any backend:
+//!
+//! ```no_run
+//! use patch_map::{BBox6dMap, map_from_obj};
+//! let map: BBox6dMap = map_from_obj("floorplan.obj")?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use geo::{Contains, Coord, LineString, MultiPolygon, Polygon as GeoPolygon, unary_union};
 use patch_core::{
-    Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch, Vector3,
-    plane_frame,
+    FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Polygon, Real, TrimeshPatch,
+    Vector3, plane_frame,
 };
 use pointcloud::PolygonMesh;
+use std::path::Path;
 
 /// Parameters of [`planar_patches_from_mesh`]. No `Default`: the tolerances depend on the
 /// mesh's units and noise; [`MeshToPatchesConfig::exact_cad`] suits exported CAD or synthetic
@@ -165,6 +174,31 @@ pub fn planar_patches_from_mesh(
     (patches, stats)
 }
 
+/// Why [`map_from_obj`] failed; `E` is the backend's [`FromPatches::Error`].
+#[derive(Debug, thiserror::Error)]
+pub enum ObjMapError<E: std::error::Error + 'static> {
+    /// The OBJ file could not be read (the error names the file and the line).
+    #[error(transparent)]
+    Read(#[from] pointcloud::io::Error),
+    /// The backend refused the patches.
+    #[error("building the map: {0}")]
+    Build(#[source] E),
+}
+
+/// Reads the OBJ mesh at `path` ([`pointcloud::io::read_mesh`]), turns its faces into patches
+/// with [`MeshToPatchesConfig::exact_cad`] ([`planar_patches_from_mesh`]) and builds a map of
+/// backend `M` from them: what `patchnav map build` does with an OBJ file. For other
+/// tolerances, or to see the [`MeshToPatchesStats`], call those two functions yourself.
+///
+/// # Errors
+/// [`ObjMapError::Read`] if the file cannot be read or is not a valid OBJ mesh,
+/// [`ObjMapError::Build`] if the backend refuses a patch.
+pub fn map_from_obj<M: FromPatches>(path: impl AsRef<Path>) -> Result<M, ObjMapError<M::Error>> {
+    let mesh = pointcloud::io::read_mesh(path.as_ref())?;
+    let (patches, _) = planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
+    M::from_patches(patches).map_err(ObjMapError::Build)
+}
+
 fn ring_points(ring: &LineString<Real>) -> Vec<Point2> {
     let mut pts: Vec<Point2> = ring.coords().map(|c| Point2::new(c.x, c.y)).collect();
     if pts.len() > 1 && pts.first() == pts.last() {
@@ -189,7 +223,7 @@ fn trimesh_of(triangles: &[[Point3; 3]]) -> Option<TrimeshPatch> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use patch_core::{BruteForceMap, FromPatches, ProximityQuery};
+    use patch_core::{BruteForceMap, FromPatches, PatchMap, ProximityQuery};
 
     fn quad(mesh_v: &mut Vec<Point3>, faces: &mut Vec<Vec<u32>>, c: [[f64; 3]; 4]) {
         let base = mesh_v.len() as u32;
@@ -290,5 +324,25 @@ mod tests {
         let (patches, stats) = planar_patches_from_mesh(&mesh, &MeshToPatchesConfig::exact_cad());
         let triangles: usize = patches.iter().map(|p| p.num_triangles_hint()).sum();
         assert!(triangles >= 4, "nothing is lost: {stats:?}");
+    }
+
+    #[test]
+    fn map_from_obj_reads_any_backend_and_names_bad_files() {
+        // A unit square split into two triangles, and a wall standing on one of its edges.
+        let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\n\
+                   f 1 2 3\nf 1 3 4\nf 1 2 6 5\n";
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("corner.obj");
+        std::fs::write(&path, obj).unwrap();
+        let polygons: crate::PolygonMap = map_from_obj(&path).unwrap();
+        let trimesh: crate::TrimeshMap = map_from_obj(&path).unwrap();
+        assert_eq!(polygons.len(), 2, "the floor's triangles are united, the wall is one patch");
+        assert_eq!(trimesh.len(), 2);
+
+        let missing = map_from_obj::<crate::BBox6dMap>(dir.path().join("missing.obj"));
+        assert!(matches!(missing, Err(ObjMapError::Read(_))), "{missing:?}");
+        std::fs::write(&path, "v 0 0 0\nf 1 2 3\n").unwrap();
+        let err = map_from_obj::<crate::BBox6dMap>(&path).unwrap_err();
+        assert!(err.to_string().contains("corner.obj"), "{err}");
     }
 }

@@ -70,7 +70,8 @@
 //! [`MapFile`] saves and loads each backend through the [`mapfile`] container (header with
 //! backend tag and counts, checksums, bincode payload; indices are rebuilt on load);
 //! [`load_any`] reads any of them into an [`AnyMap`]. [`MemoryUsage`] reports the heap bytes a
-//! map owns.
+//! map owns. [`map_from_obj`] builds a map of any backend from an OBJ mesh, its faces as
+//! planar patches ([`from_mesh`]).
 
 pub mod bbox6d;
 pub mod compare;
@@ -87,7 +88,9 @@ pub mod sampling;
 pub use patch_core::triangulate;
 pub mod trimesh;
 
-pub use from_mesh::{MeshToPatchesConfig, MeshToPatchesStats, planar_patches_from_mesh};
+pub use from_mesh::{
+    MeshToPatchesConfig, MeshToPatchesStats, ObjMapError, map_from_obj, planar_patches_from_mesh,
+};
 pub use point_cloud::{PointCloudMap, PointCloudMapError};
 pub use sampling::{SamplingError, sample_patch_points};
 

@@ -136,6 +136,10 @@
 //! assert!((path.last().unwrap() - problem.goals[0].center).norm() <= 0.3);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! The points, boxes and map trait of these signatures ([`Point3`], [`Aabb`], [`Real`],
+//! [`PatchMap`]) are `patch-core`'s, re-exported here. `examples/plan_on_mesh.rs` plans on an
+//! OBJ mesh in a `patch-map` backend (`cargo run -p roadmap --example plan_on_mesh`).
 
 mod connect;
 mod evasion;
@@ -171,3 +175,8 @@ pub use rrt_star::{RrtStar, RrtStarConfig};
 pub use smoothing::{ShortcutConfig, shortcut_path};
 pub use space::{Goal, PlanningSpace, Problem, SpaceError};
 pub use termination::{AnyOf, Deadline, GoalReached, MaxIterations, Progress, Termination};
+
+// The `patch-core` vocabulary of this crate's signatures (points and boxes of the space and the
+// problem; the map trait whose `bounds` is the usual sampling box), so a program that plans on a
+// map built elsewhere needs no direct `patch-core` dependency for them.
+pub use patch_core::{Aabb, PatchMap, Point3, Real};
