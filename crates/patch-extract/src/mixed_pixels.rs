@@ -95,7 +95,7 @@
 //! Simulated SICK S300 scans (σ = 3 cm, mixed pixels with probability 0.5 at edges above 5 cm)
 //! at full resolution (541 × 361 beams at 0.5°) and at 1° (271 × 181), the ±90° columns
 //! dropped as the project does, [`MixedPixelConfig::alrf`], 4 scan poses at 0.5 m height for
-//! each of the seeds 1, 2 and 3 of each scene; truth from the simulator (`tests/mixed_pixels.rs`,
+//! each of the seeds 1, 2 and 3 of each scene; truth from the simulator (`tests/it/mixed_pixels.rs`,
 //! `report_full_resolution`; the time is the best of 5 runs per scan, release build, on a
 //! shared 2-core machine):
 //!

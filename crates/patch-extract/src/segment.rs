@@ -102,7 +102,7 @@
 //! scene-sim's lab (≈ 190,000 points, 3 cm noise) takes ≈ 95 ms, ≈ 215 ms with every window
 //! fitted up front, `atan2` for every seed stride and the generic eigensolver (measured with
 //! `patchnav extract`'s stage times); see also the ignored test `measure_lab_scans` in
-//! `tests/segment.rs`.
+//! `tests/it/segment.rs`.
 //!
 //! # Actuated LRF scans
 //! The ±90° beam column of an actuated LRF sees one line in every row (thesis App. A); run
@@ -866,7 +866,7 @@ fn seed_window_general(
 /// σ = 3 cm. The ALRF's 5 × 5 contiguous windows at 0.5° spacing span 3σ at about 2.6 m (away
 /// from the rotation axis), so only nearer surfaces, and pixels near the axis where the rows
 /// crowd together, get wider windows. Measured on 8 scans of scene-sim's lab (σ = 3 cm;
-/// `tests/lab_coverage.rs`, points whose noise-free hit lies within 5 cm of a merged patch):
+/// `tests/it/lab_coverage.rs`, points whose noise-free hit lies within 5 cm of a merged patch):
 /// 0 (contiguous): 96.4 %, a box face 0.8 m from the sensor missed; 3σ: 98.3 %; 4σ: 98.2 %;
 /// 6σ: 94.4 % and 8σ: 93.7 % (with strides up to 8: windows wider than small faces seed
 /// nothing on them).

@@ -16,7 +16,7 @@
 //! | dark-material | "dark and too close trouser material" (Fig 2.19b) | dark trousers (4 %) at 2.5 m and black rubber tyres (2 %) at 3 m in a white room |
 //! | sun | "sun causes random noise" (Fig 2.19c) | sunlight through a window on the floor and on a locker at ≈ 3 m |
 //!
-//! `cargo test -p sensor-tof --test scenes -- --nocapture` prints the % discarded pixels of
+//! `cargo test -p sensor-tof --test it scenes:: -- --nocapture` prints the % discarded pixels of
 //! the AAT, AT 160 and AT 240 on each scene beside Table 2.4, with what the truth says about
 //! them (wrapped pixels kept, correct pixels dropped).
 //!

@@ -65,7 +65,7 @@
 //! deviation of `σ_r = R_amb σ / (2π √2 A) ≈ 1.7 cm` (`σ² = g B + σ_read²`; measured: 1.6 cm);
 //! a white wall at 1 m has ≈ 2 mm at the centre and ≈ 1.3 cm in the dim corners (Fig 2.7c
 //! reports per-pixel variances between 5.6·10⁻⁶ and 3.9·10⁻⁴ at 1 m, i.e. 2.4 mm to 2 cm if in
-//! m²). The test `noise_calibration` in `tests/sim.rs` measures it.
+//! m²). The test `noise_calibration` in `tests/it/sim.rs` measures it.
 
 use crate::camera::{demodulate, modulate, phase_from_range, range_from_phase};
 use crate::filter::illumination_table;

@@ -42,7 +42,7 @@
 //! It fixes what is local: single pixels and patches up to 3 pixels across. It cannot decide a
 //! whole region: a dark object and a wrapped wall both arrive as a region of flagged pixels, and
 //! at the region's edge both hypotheses are equally supported. On the simulated scenes of
-//! Table 2.4 (the ignored test `scores_on_the_six_scenes` in `tests/spatial.rs`) the AAT's
+//! Table 2.4 (the ignored test `scores_on_the_six_scenes` in `tests/it/spatial.rs`) the AAT's
 //! mistakes are such regions (dark material, sunlit areas, scattering), so the default check
 //! changes a few dozen pixels per frame; dropping output pixels with fewer than 3 agreeing
 //! neighbours ([`SpatialConfig::isolation_support`]) halves the gross errors of the AAT with

@@ -62,7 +62,7 @@
 //! # On the simulated scenes
 //!
 //! On the six scenes of Table 2.4 simulated at 20 and 5 MHz (the ignored test
-//! `scores_on_the_six_scenes` in `tests/two_freq.rs`), the preset outputs about as many pixels
+//! `scores_on_the_six_scenes` in `tests/it/two_freq.rs`), the preset outputs about as many pixels
 //! within 5 cm of the truth as the AAT with unwrapping while discarding a quarter of the pixels;
 //! its output has almost no gross errors (more than 1 m off: 1.7 % against the unwrapping AAT's
 //! 25 %), and a plain amplitude threshold of 10 on both frames removes the remaining ones

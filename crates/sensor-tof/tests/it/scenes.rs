@@ -1,5 +1,5 @@
 //! The six scenes of Table 2.4: each builds, shows its effect in the truth, and the filters
-//! behave as the thesis reports qualitatively. `cargo test -p sensor-tof --test scenes --
+//! behave as the thesis reports qualitatively. `cargo test -p sensor-tof --test it scenes:: --
 //! --nocapture` prints the % discarded pixels beside the thesis's.
 
 use pointcloud::{RangeKind, Real};

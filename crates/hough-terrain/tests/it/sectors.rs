@@ -1,7 +1,7 @@
 //! The per-sector mode on a floor with an obstacle on the left: the whole frame says "floor,
 //! drivable", the sectors say "left blocked, centre and right free".
 
-mod common;
+use crate::common;
 
 use common::{camera_pose, deg, mount};
 use hough_terrain::{HoughClassifier, HoughConfig, SectorClassifier, SectorGrid, TerrainClass};

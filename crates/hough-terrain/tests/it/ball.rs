@@ -1,7 +1,7 @@
 //! The equal-area ball accumulator: the three planes of a box corner in any orientation, and
 //! the floor and wall of a simulated scene, against their true planes.
 
-mod common;
+use crate::common;
 
 use hough_terrain::{BallAccumulator, BallConfig, BallPlane, refine_plane};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};

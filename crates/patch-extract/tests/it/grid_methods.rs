@@ -292,7 +292,7 @@ proptest! {
 /// The survey benchmark (thesis Figs 5.12–5.14) on simulated scans of the lab: per method the
 /// time, polygon and triangle counts and mean spikyness, with scene-sim surface labels as the
 /// regions (regions of at least 30 pixels). Run with
-/// `cargo test --release -p patch-extract --test grid_methods survey_benchmark -- --ignored --nocapture`.
+/// `cargo test --release -p patch-extract --test it grid_methods::survey_benchmark -- --ignored --nocapture`.
 #[test]
 #[ignore = "benchmark; run in release with --nocapture"]
 fn survey_benchmark() {

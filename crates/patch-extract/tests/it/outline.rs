@@ -577,7 +577,7 @@ fn region_to_patch_reports_degenerate_regions() {
     assert!(patches[0].polygon().num_vertices() <= 6);
 }
 
-/// Release measurement: `cargo test --release -p patch-extract --test outline -- --ignored
+/// Release measurement: `cargo test --release -p patch-extract --test it outline:: -- --ignored
 /// --nocapture measure_region_to_patch`.
 #[test]
 #[ignore = "measurement; run in release with --nocapture"]

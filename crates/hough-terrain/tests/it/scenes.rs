@@ -2,7 +2,7 @@
 //! Rugbot-like pose (0.45 m up, level; see `common`). Cases well inside their class are asserted
 //! for three noise seeds; every case is printed (`--nocapture`).
 
-mod common;
+use crate::common;
 
 use common::{deg, mount, sr_frame};
 use hough_terrain::{Classification, HoughClassifier, HoughConfig, Rule, TerrainClass};

@@ -3,7 +3,7 @@
 //!
 //! The full-resolution figures of the module docs come from the ignored
 //! `report_full_resolution`:
-//! `cargo test --release -p patch-extract --test mixed_pixels -- --ignored --nocapture`.
+//! `cargo test --release -p patch-extract --test it mixed_pixels:: -- --ignored --nocapture`.
 
 use patch_extract::mixed_pixels::{
     MixedPixelConfig, MixedPixelError, mixed_pixels, remove_mixed_pixels,

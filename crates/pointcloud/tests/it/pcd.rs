@@ -7,7 +7,7 @@ use pointcloud::{FieldData, Point3, PointCloud, ScalarField, Vector3};
 use proptest::collection::vec;
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use common::*;
 
 fn read(bytes: &[u8]) -> Result<PointCloud, Error> {

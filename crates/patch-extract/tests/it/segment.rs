@@ -320,7 +320,7 @@ fn empty_clouds_give_empty_segmentations() {
 }
 
 /// Release-mode measurements for the report, on three poses in the lab:
-/// `cargo test --release -p patch-extract --test segment -- --ignored --nocapture`.
+/// `cargo test --release -p patch-extract --test it segment:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "measurement; run in release"]
 fn measure_lab_scans() {

@@ -1,7 +1,7 @@
 //! The streaming classifier: inputs (slices, organised clouds), typed errors, the preprocessing
 //! test, buffer reuse from frame to frame, parallel = serial, and the histogram export.
 
-mod common;
+use crate::common;
 
 use common::{deg, mount, sr_frame, stereo_frame};
 use hough_terrain::{

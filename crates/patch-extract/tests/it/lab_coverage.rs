@@ -192,7 +192,7 @@ fn config_from_env() -> PipelineConfig {
     config
 }
 
-/// Release-mode measurement: `cargo test --release -p patch-extract --test lab_coverage --
+/// Release-mode measurement: `cargo test --release -p patch-extract --test it lab_coverage:: --
 /// --ignored --nocapture`. Environment: `LAB_SCANS` (8), `LAB_STEP` (0.5°), `LAB_STRIDE` (4).
 #[test]
 #[ignore = "measurement; run in release"]

@@ -1,0 +1,9 @@
+//! Integration tests of `hough-terrain`, one binary (`cargo test -p hough-terrain --test it`).
+
+mod algorithm3;
+mod ball;
+mod common;
+mod literal;
+mod scenes;
+mod sectors;
+mod streaming;

@@ -1,0 +1,12 @@
+//! Integration tests of `pointcloud`, one binary (`cargo test -p pointcloud --test it`).
+
+mod cloud_paths;
+mod common;
+mod depth_png;
+mod kitti;
+mod obj;
+mod pcd;
+mod ply;
+mod real_data;
+mod uos;
+mod xyz;
