@@ -1,10 +1,9 @@
 //! Loads every file of our formats in the real-data folder and checks the counts its
 //! `SOURCE.md` files state.
 //!
-//! The folder is `$PATCHNAV_REAL_DATA` if set, else `shared/data/real` next to the repository
-//! checkout (`../../../shared/data/real` from this crate). When it is missing the tests print
-//! `SKIPPED: real data folder not found at ...` to stderr (uncaptured, so it shows in every
-//! run's output) and pass. The exchange-format mesh is looked up likewise at `$PATCHNAV_BENCH` or `shared/bench` next to the checkout.
+//! The folders are found by `shared_data` (`$PATCHNAV_REAL_DATA` or `shared/data/real` next
+//! to the checkout; the exchange-format mesh at `$PATCHNAV_BENCH` or `shared/bench`): missing,
+//! they skip with a `SKIPPED` line, or fail where `PATCHNAV_REQUIRE_DATA` is set (CI).
 
 use pointcloud::io::depth_png::{DepthCamera, read_depth_png, read_range_png};
 use pointcloud::io::kitti::{KittiReadOptions, read_kitti_bin};
@@ -15,28 +14,8 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-fn shared_dir(var: &str, relative: &str) -> Option<PathBuf> {
-    let dir = match std::env::var_os(var) {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared").join(relative),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        // Written straight to the stderr handle, not with `eprintln!`, so the test harness does
-        // not capture it: a skipped check must be visible in every test run's output.
-        use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
-            "SKIPPED: real data folder not found at {} (set {var} to run these checks)",
-            dir.display()
-        );
-        None
-    }
-}
-
 fn real_data() -> Option<PathBuf> {
-    shared_dir("PATCHNAV_REAL_DATA", "data/real")
+    shared_data::real_data("")
 }
 
 fn open(path: &Path) -> BufReader<File> {
@@ -298,7 +277,7 @@ fn octomap_voxel_ply() {
 
 #[test]
 fn bench_floorplan_mesh() {
-    let Some(dir) = shared_dir("PATCHNAV_BENCH", "bench") else { return };
+    let Some(dir) = shared_data::bench("") else { return };
     let path = dir.join("floorplan.obj");
     let m = read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.num_vertices(), 188);

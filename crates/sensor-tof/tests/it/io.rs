@@ -315,22 +315,7 @@ proptest! {
 }
 
 fn real_frame_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("PATCHNAV_REAL_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real"),
-    }
-    .join("ifm_o3r_tof_frame");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
-            "SKIPPED: real ifm frame not found at {} (set PATCHNAV_REAL_DATA)",
-            dir.display()
-        );
-        None
-    }
+    shared_data::real_data("ifm_o3r_tof_frame")
 }
 
 /// The ifm O3R frame: its own sidecar is recognised, the pair and the 8-bit confidence read, and
