@@ -22,8 +22,8 @@
 //!   points in k-d trees and Algorithm 10 for capsule steps ([`point_cloud`]).
 //!
 //! # Capabilities
-//! Checked at compile time by `tests/capabilities.rs`; the tolerance is the one each backend's
-//! conformance suite runs with (`tests/conformance.rs`, against the reference map):
+//! Checked at compile time by `tests/it/capabilities.rs`; the tolerance is the one each backend's
+//! conformance suite runs with (`tests/it/conformance.rs`, against the reference map):
 //!
 //! | backend | map | add | proximity | line unspec. | line spec. | capsule unspec. | capsule spec. | tolerance |
 //! |---|---|---|---|---|---|---|---|---|

@@ -8,7 +8,7 @@
 //!
 //! Run with `cargo bench -p roadmap --bench volume -- --warm-up-time 1 --measurement-time 3`.
 //! The 10,000-capsule measurement of the issue is the ignored test `rasterise_lab_scale_timing`
-//! in `tests/volume.rs`.
+//! in `tests/it/volume.rs`.
 
 use std::hint::black_box;
 

@@ -13,7 +13,7 @@ use roadmap::{
     RrtConfig, ShortcutConfig, shortcut_path,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 fn is_free(map: &BruteForceMap, a: Point3, b: Point3) -> bool {

@@ -5,7 +5,7 @@ use pointcloud::{Point3, SensorPose};
 use scene_sim::{RangeCamera, RangeSensor, TerrainSpec, terrain};
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 /// An SR-3000 frame of `spec` from a level camera 0.45 m above the floor, written as PLY.

@@ -15,7 +15,7 @@ use roadmap::{
     PlanningSpace, Prm, PrmConfig, Problem, Roadmap,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 /// The corridor's inside: 10 m long, 2 m wide, 1.5 m high.

@@ -1,6 +1,6 @@
 //! `patchnav extract`: simulated scans in, a map file and an OBJ export out.
 
-mod common;
+use crate::common;
 use common::*;
 
 fn text(bytes: &[u8]) -> String {

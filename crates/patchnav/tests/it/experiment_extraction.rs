@@ -4,7 +4,7 @@
 use std::collections::BTreeSet;
 use std::sync::OnceLock;
 
-mod common;
+use crate::common;
 use common::*;
 
 const QUICK: &[&str] = &["experiment", "extraction", "--quick", "--real", "/nonexistent"];

@@ -12,7 +12,7 @@ use roadmap::{
     Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace, Problem, RrtConnect, Termination,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -11,7 +11,7 @@ use roadmap::{
     Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -12,7 +12,7 @@ use sensor_tof::{
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
+use crate::common;
 use common::*;
 
 /// `patchnav tof filter --range R --amplitude A --meta M EXTRA...`.
@@ -362,17 +362,7 @@ fn calibrate_recovers_a_known_parabola() {
 /// The real ifm O3R frame through the filter: its own sidecar, 9,962 measured pixels.
 #[test]
 fn the_real_ifm_frame_filters() {
-    let dir = match std::env::var_os("PATCHNAV_REAL_DATA") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real"),
-    }
-    .join("ifm_o3r_tof_frame");
-    if !dir.is_dir() {
-        use std::io::Write as _;
-        let _ =
-            writeln!(std::io::stderr(), "SKIPPED: real ifm frame not found at {}", dir.display());
-        return;
-    }
+    let Some(dir) = shared_data::real_data("ifm_o3r_tof_frame") else { return };
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("ifm.ply");
     let o = patchnav(&[

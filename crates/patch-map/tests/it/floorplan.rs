@@ -1,26 +1,15 @@
 //! The shared benchmark floor plan (an OBJ of triangles) turned into planar patches: nothing is
 //! lost, and coplanar triangles merge. Runs when the benchmark folder exists (`shared/bench`
-//! next to the checkout, or `$PATCHNAV_BENCH`); prints a loud `SKIPPED` line otherwise.
+//! next to the checkout, or `$PATCHNAV_BENCH`; `shared_data`): skipped with a loud `SKIPPED` line
+//! otherwise, failed where `PATCHNAV_REQUIRE_DATA` is set (CI).
 
 use patch_core::{BruteForceMap, FromPatches, Patch, Point3, ProximityQuery, TrimeshPatch, na};
 use patch_map::{MeshToPatchesConfig, planar_patches_from_mesh};
 use pointcloud::io::read_mesh;
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn bench_dir() -> Option<PathBuf> {
-    let dir = match std::env::var_os("PATCHNAV_BENCH") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench"),
-    };
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        // Straight to the stderr handle so the harness does not capture it.
-        let _ =
-            writeln!(std::io::stderr(), "SKIPPED: benchmark folder not found at {}", dir.display());
-        None
-    }
+    shared_data::bench("")
 }
 
 #[test]

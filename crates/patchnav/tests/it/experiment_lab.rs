@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Small maps: one ALRF scan at 2°, 0.5 m triangles.

@@ -5,7 +5,7 @@ use serde_json::Value;
 use std::path::Path;
 use std::process::Output;
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Asserts a failure reported as one `error:` line and exit code 1.

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::*;
 
 const START: [f64; 3] = [3.0, 3.0, 1.0];

@@ -12,7 +12,7 @@ use roadmap::{
     Problem,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 fn assert_edges_free(map: &BruteForceMap, prm: &dyn Planner) {

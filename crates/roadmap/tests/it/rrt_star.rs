@@ -15,7 +15,7 @@ use roadmap::{
     RrtStarConfig,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Every vertex's cost is the length of its tree path, and the tree is consistent with the

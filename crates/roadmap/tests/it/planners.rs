@@ -14,7 +14,7 @@ use roadmap::{
     Problem, Roadmap, Rrt, RrtConfig, Sampler, Termination,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

@@ -15,7 +15,7 @@ use roadmap::{
     Problem, Roadmap, Rrt, RrtConfig,
 };
 
-mod common;
+use crate::common;
 use common::*;
 
 fn quad(corners: [Point3; 4], holes: Vec<Vec<Point3>>) -> PlanarPatch {

@@ -6,7 +6,7 @@ use patch_core::{BruteForceMap, CapsuleStep, Counted, UnspecificStepIntersector}
 use petgraph::algo::is_cyclic_undirected;
 use roadmap::{MaxIterations, PathMetrics, Planner, PlannerStatus, Prm, PrmConfig};
 
-mod common;
+use crate::common;
 use common::*;
 
 /// Whether the robot's sphere at `p` touches the map.
