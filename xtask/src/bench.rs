@@ -26,6 +26,7 @@
 //! (`PATCHNAV_LAB_VOLUME_K`, `_PRM_K`, `_STARTS`, `_CELLS`).
 
 use anyhow::{Context, Result, bail};
+use patch_map::Backend;
 use serde_json::Value;
 use std::collections::HashSet;
 use std::io::{BufRead as _, Write as _};
@@ -94,7 +95,7 @@ impl LabMapParams {
 
     /// The arguments of `patchnav` that build the map of `kind` into `out`.
     pub fn patchnav_args(&self, kind: &str, out: &Path) -> Vec<String> {
-        let backend = if kind == "pc" { "pointcloud" } else { "polygon" };
+        let backend = if kind == "pc" { Backend::PointCloud } else { Backend::Polygon };
         let mut a: Vec<String> = [
             "--quiet",
             "map",
@@ -106,7 +107,7 @@ impl LabMapParams {
             "--source",
             "scans",
             "--backend",
-            backend,
+            backend.name(),
         ]
         .iter()
         .map(|s| s.to_string())

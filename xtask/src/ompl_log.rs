@@ -42,6 +42,7 @@
 //! Arena strips the prefix as for OMPL's.
 
 use anyhow::{Context, Result};
+use roadmap::PlannerKind;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -72,21 +73,31 @@ pub fn status_value(status: &str) -> usize {
     }
 }
 
-/// The OMPL-style name of a matrix planner (`rrt-star` → `geometric_RRTstar`).
+/// The OMPL-style name of a matrix planner (`rrt-star` → `geometric_RRTstar`); a name that is
+/// no [`PlannerKind`]'s keeps its letters and digits.
 pub fn planner_name(planner: &str) -> String {
-    let name = match planner {
-        "rrt" => "RRT",
-        "rrt-star" => "RRTstar",
-        "rrt-connect" => "RRTConnect",
-        "prm" => "PRM",
-        "prm-star" => "PRMstar",
-        "lazy-prm" => "LazyPRM",
-        "evasion-rrt" => "EvasionRRT",
-        "ma-prm" => "MAPRM",
-        "ma-rrt" => "MARRT",
-        other => other,
+    let name: &str = match planner.parse() {
+        Ok(kind) => ompl_name(kind),
+        Err(_) => planner,
     };
     format!("geometric_{}", name.replace(|c: char| !c.is_ascii_alphanumeric(), "_"))
+}
+
+/// The OMPL-style name of `kind` (OMPL's own where it has the planner).
+fn ompl_name(kind: PlannerKind) -> &'static str {
+    match kind {
+        PlannerKind::Rrt => "RRT",
+        PlannerKind::RrtStar => "RRTstar",
+        PlannerKind::RrtConnect => "RRTConnect",
+        PlannerKind::Prm => "PRM",
+        PlannerKind::PrmStar => "PRMstar",
+        PlannerKind::LazyPrm => "LazyPRM",
+        PlannerKind::EvasionRrt => "EvasionRRT",
+        PlannerKind::MaPrm => "MAPRM",
+        PlannerKind::MaRrt => "MARRT",
+        // OMPL's PRM builds this roadmap; the name tells them apart.
+        PlannerKind::PrmValid => kind.name(),
+    }
 }
 
 /// A run property: the matrix metric, the OMPL property name and its type.

@@ -55,12 +55,13 @@ use crate::roadmap::lab_scene::near_corner;
 use crate::roadmap::{MatrixArgs, lab_maps};
 use anyhow::{Context, Result, bail};
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
-use patch_map::AnyMap;
+use patch_map::{AnyMap, Backend};
 use pointcloud::Aabb;
 use roadmap::thesis;
 use roadmap::volume::{CongruenceTable, VoxelGrid, explored_part};
 use roadmap::{
-    MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
+    MaxIterations, Planner, PlannerKind, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
+    Rrt, RrtConfig,
 };
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -74,11 +75,11 @@ const RADIUS: Real = 0.3;
 const STEP: Real = 1.0;
 /// The backend of the patch maps (one BVH over all triangles: the role of the thesis's
 /// Bullet, in which it ran every patch map).
-const PATCH_BACKEND: &str = "trimesh";
+const PATCH_BACKEND: Backend = Backend::Trimesh;
 /// The backend of the pc map (Algorithm 10).
-const PC_BACKEND: &str = "pointcloud";
+const PC_BACKEND: Backend = Backend::PointCloud;
 /// The planners, in the order of the thesis's tables (6.2 before 6.4).
-const PLANNERS: [&str; 2] = ["rrt", "prm"];
+const PLANNERS: [PlannerKind; 2] = [PlannerKind::Rrt, PlannerKind::Prm];
 
 /// Iterations of every RRT (K); default [`DEFAULT_K`].
 pub(crate) const K_ENV: &str = "PATCHNAV_LAB_VOLUME_K";
@@ -206,7 +207,7 @@ pub(crate) struct Contents {
 /// One of the four maps, in the backend it is planned in.
 struct LabMap {
     kind: &'static str,
-    backend: &'static str,
+    backend: Backend,
     map: AnyMap,
     /// The box it samples in (its own, thesis L6460).
     bounds: Aabb,
@@ -287,7 +288,7 @@ fn run_with(
     );
     let grids = run_items(&maps, &items, &empty, config)?;
     let names: Vec<&str> = maps.iter().map(|m| m.kind).collect();
-    for (p, planner) in PLANNERS.iter().enumerate() {
+    for (p, &planner) in PLANNERS.iter().enumerate() {
         let table = CongruenceTable::new(names.iter().copied().zip(grids.iter().map(|g| &g[p])))
             .context("the congruence table")?;
         let params = Params {
@@ -484,7 +485,7 @@ fn explore(
 
 /// What every volume row of one planner carries.
 struct Params<'a> {
-    planner: &'static str,
+    planner: PlannerKind,
     starts: usize,
     k: u64,
     cells: u32,
@@ -499,14 +500,14 @@ impl Params<'_> {
         let runs = self.starts as u64 * self.config.seeds;
         let mut row = json!({
             "case": case, "metric": metric, "value": value, "unit": unit,
-            "planner": self.planner, "starts": self.starts, "seeds": self.config.seeds,
+            "planner": self.planner.name(), "starts": self.starts, "seeds": self.config.seeds,
             "first_seed": self.config.seed, "runs": runs, "k": self.k, "cells": self.cells,
             "cell_size_m": self.cell_size, "radius": RADIUS, "jobs": self.config.jobs,
-            "table": if self.planner == "rrt" { "6.2" } else { "6.4" },
+            "table": if self.planner == PlannerKind::Rrt { "6.2" } else { "6.4" },
         });
         if let Some(obj) = row.as_object_mut() {
             // The RRT's step; the thesis's PRM has no edge-length limit, only its neighbours.
-            if self.planner == "rrt" {
+            if self.planner == PlannerKind::Rrt {
                 obj.insert("step".into(), STEP.into());
             } else {
                 obj.insert("neighbours".into(), PrmConfig::thesis().neighbours.into());
@@ -528,7 +529,7 @@ fn volume_rows(table: &CongruenceTable, maps: &[LabMap], params: &Params<'_>) ->
         let with_map = |mut row: Value| {
             if let Some(obj) = row.as_object_mut() {
                 obj.insert("map".into(), m.kind.into());
-                obj.insert("backend".into(), m.backend.into());
+                obj.insert("backend".into(), m.backend.name().into());
             }
             row
         };
@@ -569,7 +570,7 @@ fn emit_contents(
     for (metric, value, unit) in metrics {
         let mut row = json!({
             "case": format!("lab-volume/contents/{}", m.kind), "metric": metric, "value": value,
-            "unit": unit, "map": m.kind, "backend": m.backend, "table": "6.1",
+            "unit": unit, "map": m.kind, "backend": m.backend.name(), "table": "6.1",
         });
         if let (Some(key), Some(obj)) = (lab_maps_key, row.as_object_mut()) {
             obj.insert("lab_maps".into(), key.into());

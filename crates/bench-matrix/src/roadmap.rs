@@ -53,32 +53,25 @@ pub(crate) mod lab_scene;
 mod planners;
 
 use anyhow::{Context, Result, bail};
-use patch_core::{FromPatches, Patch, Point3, Real};
-use patch_map::{
-    AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
-    planar_patches_from_mesh, sample_patch_points,
-};
+use patch_core::{Patch, Point3, Real};
+use patch_map::{AnyMap, Backend, MeshToPatchesConfig, planar_patches_from_mesh};
 use roadmap::metrics::{added_length, turn_angles, upper_quartile};
 use roadmap::{
-    AnyOf, GoalReached, MaxIterations, PathMetrics, PlannerStatus, PlanningSpace, Problem,
-    ProblemFile, Termination,
+    AnyOf, GoalReached, MaxIterations, PathMetrics, PlannerKind, PlannerStatus, PlanningSpace,
+    Problem, ProblemFile, Termination,
 };
 use serde_json::{Value, json};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::str::FromStr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-
-pub(crate) use planners::PLANNERS;
 
 /// The scenes of the matrix.
 pub(crate) const SCENES: [&str; 6] =
     ["office", "lab", "lab-scans-planes", "lab-scans-hybrid", "lab-scans-trimesh", "lab-scans-pc"];
 /// A `--scene` name selecting every `lab-scans-*` scene.
 const LAB_SCANS_GROUP: &str = "lab-scans";
-/// The backends, in the thesis's column order (Simple, BB6D, OPCODE, Bullet), then the
-/// point-cloud map.
-pub(crate) const BACKENDS: [&str; 5] = ["polygon", "bbox6d", "trimesh", "rapier", "pointcloud"];
 /// Iteration cap of an office run (as `patchnav experiment office`); a run that has not
 /// reached every ROI by then fails.
 pub(crate) const OFFICE_MAX_ITERATIONS: u64 = 100_000;
@@ -87,7 +80,7 @@ pub(crate) const LAB_ITERATIONS: u64 = 1000;
 /// The checkpoints a lab run is timed at (each below or at [`LAB_ITERATIONS`]).
 const LAB_CHECKPOINTS: [u64; 3] = [100, 500, LAB_ITERATIONS];
 /// The planners the lab scene runs: RRT (Fig 6.4) and PRM (Table 6.4's roadmaps).
-const LAB_PLANNERS: [&str; 2] = ["rrt", "prm"];
+const LAB_PLANNERS: [PlannerKind; 2] = [PlannerKind::Rrt, PlannerKind::Prm];
 /// Robot radius and step of the lab runs, metres (the lab experiment's choices).
 const LAB_RADIUS: Real = 0.3;
 const LAB_STEP: Real = 1.0;
@@ -97,9 +90,9 @@ const LAB_STEP: Real = 1.0;
 pub(crate) struct MatrixArgs {
     /// Scenes (empty: all).
     pub scenes: Vec<String>,
-    /// Backends (empty: all).
+    /// Backends by name (empty: all, [`Backend::ALL`]).
     pub backends: Vec<String>,
-    /// Planners (empty: all that apply to the scene).
+    /// Planners by name (empty: all that apply to the scene).
     pub planners: Vec<String>,
     /// First seed; runs use `seed..seed + seeds`.
     pub seed: u64,
@@ -122,13 +115,8 @@ impl MatrixArgs {
                 SCENES.join(", ")
             );
         }
-        for (what, given, known) in
-            [("backend", &self.backends, &BACKENDS[..]), ("planner", &self.planners, &PLANNERS[..])]
-        {
-            if let Some(bad) = given.iter().find(|g| !known.contains(&g.as_str())) {
-                bail!("unknown {what} `{bad}`; known: {}", known.join(", "));
-            }
-        }
+        self.selected_backends()?;
+        self.selected_planners()?;
         if self.seeds == 0 || self.seeds > 1_000_000 {
             bail!("--seeds must be between 1 and 1,000,000, got {}", self.seeds);
         }
@@ -141,8 +129,14 @@ impl MatrixArgs {
         Ok(())
     }
 
-    fn wants<'a>(given: &[String], all: &[&'a str]) -> Vec<&'a str> {
-        all.iter().copied().filter(|n| given.is_empty() || given.iter().any(|g| g == n)).collect()
+    /// The backends selected, in [`Backend::ALL`] order.
+    fn selected_backends(&self) -> Result<Vec<Backend>> {
+        selected(&self.backends, &Backend::ALL)
+    }
+
+    /// The planners selected, in [`PlannerKind::ALL`] order.
+    fn selected_planners(&self) -> Result<Vec<PlannerKind>> {
+        selected(&self.planners, &PlannerKind::ALL)
     }
 
     /// The scenes to run, in [`SCENES`] order (`lab-scans` stands for every `lab-scans-*`).
@@ -161,8 +155,18 @@ impl MatrixArgs {
     }
 }
 
+/// The values of `all` named in `given` (all of them when `given` is empty), in `all`'s order.
+fn selected<T>(given: &[String], all: &[T]) -> Result<Vec<T>>
+where
+    T: FromStr + Copy + PartialEq,
+    T::Err: std::error::Error + Send + Sync + 'static,
+{
+    let given: Vec<T> = given.iter().map(|g| g.parse()).collect::<Result<_, _>>()?;
+    Ok(all.iter().copied().filter(|v| given.is_empty() || given.contains(v)).collect())
+}
+
 /// The case key of one run.
-pub(crate) fn case_key(scene: &str, backend: &str, planner: &str, seed: u64) -> String {
+pub(crate) fn case_key(scene: &str, backend: Backend, planner: PlannerKind, seed: u64) -> String {
     format!("{scene}/{backend}/{planner}/{seed}")
 }
 
@@ -180,11 +184,11 @@ struct Setup {
     scene: &'static str,
     /// The folder name of the maps built from scans (`lab-scans-*` scenes), put in every row.
     lab_maps: Option<String>,
-    maps: Vec<(&'static str, AnyMap)>,
+    maps: Vec<(Backend, AnyMap)>,
     space: PlanningSpace,
     query: Problem,
     mode: Mode,
-    planners: Vec<&'static str>,
+    planners: Vec<PlannerKind>,
 }
 
 /// Runs the matrix; `emit` gets every row, the rows of one case together, `solved` last. The
@@ -201,7 +205,8 @@ fn run_with(
     emit: &mut dyn FnMut(Value) -> Result<()>,
 ) -> Result<()> {
     args.validate()?;
-    let backends = MatrixArgs::wants(&args.backends, &BACKENDS);
+    let backends = args.selected_backends()?;
+    let wanted_planners = args.selected_planners()?;
     let mut scanned: Option<lab_maps::LabMaps> = None;
     for scene in args.scenes() {
         let t0 = Instant::now();
@@ -233,15 +238,11 @@ fn run_with(
             setup.maps.len(),
             t0.elapsed().as_secs_f64()
         );
-        let planners: Vec<&str> = setup
-            .planners
-            .iter()
-            .copied()
-            .filter(|p| args.planners.is_empty() || args.planners.iter().any(|g| g == p))
-            .collect();
+        let planners: Vec<PlannerKind> =
+            setup.planners.iter().copied().filter(|p| wanted_planners.contains(p)).collect();
         let mut items = Vec::new();
         let mut skipped = 0;
-        for (b, (backend, _)) in setup.maps.iter().enumerate() {
+        for (b, &(backend, _)) in setup.maps.iter().enumerate() {
             for &planner in &planners {
                 for seed in args.seed..args.seed + args.seeds {
                     if args.skip.contains(&case_key(scene, backend, planner, seed)) {
@@ -265,7 +266,7 @@ fn run_with(
 /// Runs `items` on `jobs` threads sharing the maps; rows go to `emit` from this thread.
 fn run_items(
     setup: &Setup,
-    items: &[(usize, &'static str, u64)],
+    items: &[(usize, PlannerKind, u64)],
     jobs: usize,
     emit: &mut dyn FnMut(Value) -> Result<()>,
 ) -> Result<()> {
@@ -280,7 +281,7 @@ fn run_items(
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&(b, planner, seed)) = items.get(i) else { break };
-                    let (backend, map) = (&setup.maps[b].0, &setup.maps[b].1);
+                    let (backend, map) = (setup.maps[b].0, &setup.maps[b].1);
                     let rows = match run_case(setup, backend, map, planner, seed, jobs) {
                         Ok(Ok(rows)) => rows,
                         Ok(Err(reason)) => {
@@ -336,17 +337,17 @@ impl Termination for Checkpoints {
 /// One run: its rows, or (inner error) why the planner cannot run on this map.
 fn run_case(
     setup: &Setup,
-    backend: &str,
+    backend: Backend,
     map: &AnyMap,
-    planner_name: &str,
+    kind: PlannerKind,
     seed: u64,
     jobs: usize,
 ) -> Result<std::result::Result<Vec<Value>, String>> {
-    let mut planner = match planners::make_planner(planner_name, map, setup.space, seed) {
+    let mut planner = match planners::make_planner(kind, map, setup.space, seed) {
         Ok(p) => p,
         Err(e) => return Ok(Err(format!("{e:#}"))),
     };
-    let case = case_key(setup.scene, backend, planner_name, seed);
+    let case = case_key(setup.scene, backend, kind, seed);
     let mut metrics: Vec<(&str, Real, &str)> = Vec::new();
     let (status, cap) = match setup.mode {
         Mode::Roi(cap) => {
@@ -406,7 +407,7 @@ fn run_case(
         .map(|(metric, value, unit)| {
             json!({
                 "case": case, "metric": metric, "value": value, "unit": unit,
-                "scene": setup.scene, "backend": backend, "planner": planner_name, "seed": seed,
+                "scene": setup.scene, "backend": backend.name(), "planner": kind.name(), "seed": seed,
                 "status": status, "mode": mode, "max_iterations": cap, "jobs": jobs,
             })
         })
@@ -421,24 +422,15 @@ fn run_case(
 
 /// The map of `backend` built from `patches`; the point-cloud map samples them every
 /// `spacing` metres.
-fn build_map(backend: &str, patches: Vec<Patch>, spacing: Real) -> Result<AnyMap> {
-    Ok(match backend {
-        "polygon" => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
-        "bbox6d" => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
-        "trimesh" => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
-        "rapier" => AnyMap::Rapier(RapierMap::from_patches(patches)?),
-        "pointcloud" => AnyMap::PointCloud(PointCloudMap::from_points(&sample_patch_points(
-            &patches, spacing,
-        )?)?),
-        other => bail!("unknown backend `{other}`"),
-    })
+fn build_map(backend: Backend, patches: Vec<Patch>, spacing: Real) -> Result<AnyMap> {
+    Ok(AnyMap::from_patches(backend, patches, Some(spacing))?)
 }
 
 fn build_maps(
-    backends: &[&'static str],
+    backends: &[Backend],
     patches: &[Patch],
     spacing: Real,
-) -> Result<Vec<(&'static str, AnyMap)>> {
+) -> Result<Vec<(Backend, AnyMap)>> {
     backends
         .iter()
         .map(|&b| {
@@ -460,7 +452,7 @@ fn bench_dir() -> PathBuf {
 }
 
 /// The office scene from the shared floor plan; `None` (with a note) when it is not there.
-fn office_setup(backends: &[&'static str]) -> Result<Option<Setup>> {
+fn office_setup(backends: &[Backend]) -> Result<Option<Setup>> {
     let path = bench_dir().join("floorplan.json");
     if !path.is_file() {
         eprintln!(
@@ -484,12 +476,12 @@ fn office_setup(backends: &[&'static str]) -> Result<Option<Setup>> {
         space,
         query,
         mode: Mode::Roi(OFFICE_MAX_ITERATIONS),
-        planners: PLANNERS.to_vec(),
+        planners: PlannerKind::ALL.to_vec(),
     }))
 }
 
 /// The lab scene from its exact geometry.
-fn lab_setup(backends: &[&'static str]) -> Result<Setup> {
+fn lab_setup(backends: &[Backend]) -> Result<Setup> {
     let scene = scene_sim::lab(0).context("building the lab scene")?;
     let patches = lab_scene::scene_patches(&scene)?;
     let maps = build_maps(backends, &patches, LAB_RADIUS / 4.0)?;
@@ -514,22 +506,18 @@ fn lab_setup(backends: &[&'static str]) -> Result<Setup> {
 /// Backends without a broad phase worth the name that a default run leaves out on the
 /// trimesh map from scans: polygon and bbox6d test each of its ~55,000 patches' boxes per step
 /// and take ≈ 12 s per 1000-iteration run (about 3,000× the trimesh backend).
-const SLOW_ON_SCANNED_TRIMESH: [&str; 2] = ["polygon", "bbox6d"];
+const SLOW_ON_SCANNED_TRIMESH: [Backend; 2] = [Backend::Polygon, Backend::BBox6d];
 
 /// The backends a `lab-scans-*` scene runs: `selected`, less [`SLOW_ON_SCANNED_TRIMESH`] for the
 /// trimesh map when the backends were not named (`by_default`; a note says so).
-fn lab_scans_backends(
-    kind: &str,
-    selected: &[&'static str],
-    by_default: bool,
-) -> Vec<&'static str> {
+fn lab_scans_backends(kind: &str, selected: &[Backend], by_default: bool) -> Vec<Backend> {
     if kind != "trimesh" || !by_default {
         return selected.to_vec();
     }
+    let [a, b] = SLOW_ON_SCANNED_TRIMESH;
     eprintln!(
-        "roadmap: lab-scans-trimesh: {} left out by default (≈ 12 s per run); name them with \
-         --backend to run them",
-        SLOW_ON_SCANNED_TRIMESH.join(" and ")
+        "roadmap: lab-scans-trimesh: {a} and {b} left out by default (≈ 12 s per run); name \
+         them with --backend to run them"
     );
     selected.iter().copied().filter(|b| !SLOW_ON_SCANNED_TRIMESH.contains(b)).collect()
 }
@@ -538,7 +526,7 @@ fn lab_scans_setup(
     scene: &'static str,
     kind: &str,
     maps: &mut lab_maps::LabMaps,
-    backends: &[&'static str],
+    backends: &[Backend],
 ) -> Result<Setup> {
     let bounds = maps.bounds(kind)?;
     let space = PlanningSpace::new(bounds, LAB_RADIUS, LAB_STEP)
@@ -575,10 +563,13 @@ mod tests {
 
     #[test]
     fn the_scanned_trimesh_map_leaves_out_slow_backends_unless_they_are_named() {
-        let all: Vec<&'static str> = BACKENDS.to_vec();
+        let all: Vec<Backend> = Backend::ALL.to_vec();
         assert_eq!(lab_scans_backends("planes", &all, true), all);
         assert_eq!(lab_scans_backends("trimesh", &all, false), all);
-        assert_eq!(lab_scans_backends("trimesh", &all, true), ["trimesh", "rapier", "pointcloud"]);
+        assert_eq!(
+            lab_scans_backends("trimesh", &all, true),
+            [Backend::Trimesh, Backend::Rapier, Backend::PointCloud]
+        );
     }
 
     #[test]
@@ -663,7 +654,7 @@ mod tests {
         // By default the trimesh map leaves out the two slow backends.
         assert_eq!(cases.len(), 2 * 4 + 2 + 1, "planes, hybrid × 4 + trimesh × 2 + pc: {cases:?}");
         for kind in ["planes", "hybrid", "trimesh"] {
-            for backend in ["polygon", "bbox6d", "trimesh", "rapier"] {
+            for backend in Backend::patch_backends() {
                 let slow = kind == "trimesh" && SLOW_ON_SCANNED_TRIMESH.contains(&backend);
                 let case = format!("lab-scans-{kind}/{backend}/rrt/3");
                 assert_eq!(cases.contains(case.as_str()), !slow, "{case}");
@@ -724,7 +715,7 @@ mod tests {
         .unwrap();
         assert!(rows.is_empty());
         let map = build_map(
-            "pointcloud",
+            Backend::PointCloud,
             lab_scene::scene_patches(&scene_sim::lab(0).unwrap()).unwrap(),
             0.075,
         )
@@ -735,9 +726,9 @@ mod tests {
             0.5,
         )
         .unwrap();
-        for p in ["ma-rrt", "ma-prm", "evasion-rrt"] {
+        for p in [PlannerKind::MaRrt, PlannerKind::MaPrm, PlannerKind::EvasionRrt] {
             assert!(planners::make_planner(p, &map, space, 0).is_err(), "{p}");
         }
-        assert!(planners::make_planner("rrt", &map, space, 0).is_ok());
+        assert!(planners::make_planner(PlannerKind::Rrt, &map, space, 0).is_ok());
     }
 }

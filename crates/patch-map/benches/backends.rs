@@ -28,7 +28,10 @@ use patch_core::{
     Aabb, CapsuleStep, FromPatches, Isometry3, LineStep, Patch, PlanarPatch, Point2, Point3,
     Polygon, Real, SpecificStepIntersector, UnspecificStepIntersector, Vector3, na,
 };
-use patch_map::{BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap, sample_patch_points};
+use patch_map::{
+    BBox6dMap, Backend as BackendName, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
+    sample_patch_points,
+};
 
 /// The robot radius.
 const RADIUS: Real = 0.3;
@@ -39,10 +42,10 @@ const BATCH: usize = 256;
 
 /// The backends compared: one line each.
 fn backends(c: &mut Criterion, scene: &Scene) {
-    bench_backend::<PolygonMap>(c, scene, "polygon");
-    bench_backend::<BBox6dMap>(c, scene, "bbox6d");
-    bench_backend::<TrimeshMap>(c, scene, "trimesh");
-    bench_backend::<RapierMap>(c, scene, "rapier");
+    bench_backend::<PolygonMap>(c, scene, BackendName::Polygon.name());
+    bench_backend::<BBox6dMap>(c, scene, BackendName::BBox6d.name());
+    bench_backend::<TrimeshMap>(c, scene, BackendName::Trimesh.name());
+    bench_backend::<RapierMap>(c, scene, BackendName::Rapier.name());
     bench_point_cloud(c, scene);
 }
 
@@ -56,7 +59,8 @@ fn bench_point_cloud(c: &mut Criterion, scene: &Scene) {
     let mut g = c.benchmark_group(format!("{}/build", scene.name));
     g.sample_size(10);
     g.throughput(Throughput::Elements(scene.patches.len() as u64));
-    g.bench_function("pointcloud", |b| {
+    let name = BackendName::PointCloud.name();
+    g.bench_function(name, |b| {
         b.iter(|| PointCloudMap::from_points(black_box(&points)).expect("finite points"))
     });
     g.finish();
@@ -70,11 +74,9 @@ fn bench_point_cloud(c: &mut Criterion, scene: &Scene) {
         let mut g = c.benchmark_group(format!("{}/{query}", scene.name));
         g.throughput(Throughput::Elements(BATCH as u64));
         for (length, steps) in &scene.steps {
-            g.bench_with_input(
-                BenchmarkId::new("pointcloud", format!("{length} m")),
-                steps,
-                |b, steps| b.iter(|| run(&map, black_box(steps))),
-            );
+            g.bench_with_input(BenchmarkId::new(name, format!("{length} m")), steps, |b, steps| {
+                b.iter(|| run(&map, black_box(steps)))
+            });
         }
         g.finish();
     }

@@ -66,6 +66,11 @@
 //! how many free ones it blocks (overcautious), each with a 95 % interval, and which truth
 //! surfaces the misses hit.
 //!
+//! # Backends chosen at run time
+//! [`Backend`] names the five backends: its names are the map files' backend tags, and the
+//! names programs accept. [`AnyMap`] holds a map of any of them: [`AnyMap::from_patches`]
+//! builds one from patches, [`load_any`] reads one from a file.
+//!
 //! # Files and memory
 //! [`MapFile`] saves and loads each backend through the [`mapfile`] container (header with
 //! backend tag and counts, checksums, bincode payload; indices are rebuilt on load);
@@ -73,6 +78,8 @@
 //! map owns. [`map_from_obj`] builds a map of any backend from an OBJ mesh, its faces as
 //! planar patches ([`from_mesh`]).
 
+pub mod any_map;
+pub mod backend;
 pub mod bbox6d;
 pub mod compare;
 pub mod from_mesh;
@@ -94,12 +101,14 @@ pub use from_mesh::{
 pub use point_cloud::{PointCloudMap, PointCloudMapError};
 pub use sampling::{SamplingError, sample_patch_points};
 
+pub use any_map::{AnyMap, AnyMapError};
+pub use backend::{Backend, UnknownBackend};
 pub use bbox6d::BBox6dMap;
 pub use compare::{
     Attribution, CompareError, MapComparison, Rate, StepSampling, compare_maps, compare_on_steps,
     random_steps,
 };
-pub use persist::{AnyMap, MapFile, MemoryUsage, load_any};
+pub use persist::{MapFile, MemoryUsage, load_any};
 pub use polygon::PolygonMap;
 pub use rapier::RapierMap;
 pub use trimesh::{MeshMapError, TrimeshMap};

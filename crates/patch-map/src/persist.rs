@@ -6,7 +6,8 @@
 //!   on load; the point-cloud map stores its points. Loading goes through the validating
 //!   `Deserialize` impls of `patch-core`, so a file cannot smuggle in an invalid patch, and a
 //!   file of another backend is [`MapFileError::BackendMismatch`].
-//! * [`load_any`] reads whichever backend a file holds into an [`AnyMap`].
+//! * [`load_any`] reads whichever backend a file holds into an [`AnyMap`]; the header's tag is
+//!   parsed as a [`Backend`] (its name).
 //! * [`MemoryUsage`]: the heap bytes a map owns, counted from lengths and capacities
 //!   (`patchnav map info` and the benchmarks report it).
 //!
@@ -20,18 +21,16 @@
 
 use std::io::{Read, Write};
 
-use patch_core::{
-    Aabb, CapsuleStep, FromPatches, LineStep, MaybePatchMap, Patch, PatchMap, PatchMapVisitor,
-    Point3, Real, UnspecificStepIntersector,
-};
+use patch_core::{FromPatches, Patch, PatchMap, Point3, Real};
 
+pub use crate::any_map::AnyMap;
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
-use crate::{BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
+use crate::{BBox6dMap, Backend, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
 
 /// A map that can be written to and read from a map file ([`mapfile`](crate::mapfile)).
 pub trait MapFile: Sized {
-    /// The backend tag in the file header (printable ASCII, at most 16 bytes).
-    const BACKEND: &'static str;
+    /// The backend; its [`name`](Backend::name) is the tag in the file header.
+    const BACKEND: Backend;
 
     /// Writes the map; returns the number of bytes written.
     ///
@@ -93,19 +92,19 @@ pub fn patch_counts(patches: &[Patch]) -> MapCounts {
 }
 
 /// Reads the patch list of a patch-map file of `backend` and builds the map from it.
-fn load_patches<M>(reader: impl Read, backend: &str) -> Result<M, MapFileError>
+fn load_patches<M>(reader: impl Read, backend: Backend) -> Result<M, MapFileError>
 where
     M: FromPatches,
 {
-    let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(backend))?;
+    let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(backend.name()))?;
     M::from_patches(patches).map_err(|e| MapFileError::Decode(e.to_string()))
 }
 
 impl MapFile for PolygonMap {
-    const BACKEND: &'static str = "polygon";
+    const BACKEND: Backend = Backend::Polygon;
 
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        write_map(writer, Self::BACKEND, self.counts(), &self.patches())
+        write_map(writer, Self::BACKEND.name(), self.counts(), &self.patches())
     }
 
     fn load(reader: impl Read) -> Result<Self, MapFileError> {
@@ -118,10 +117,10 @@ impl MapFile for PolygonMap {
 }
 
 impl MapFile for BBox6dMap {
-    const BACKEND: &'static str = "bbox6d";
+    const BACKEND: Backend = Backend::BBox6d;
 
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        write_map(writer, Self::BACKEND, self.counts(), &self.patches())
+        write_map(writer, Self::BACKEND.name(), self.counts(), &self.patches())
     }
 
     /// Reads the patches and builds the forest in one go (balanced trees, O(P log P)).
@@ -135,19 +134,19 @@ impl MapFile for BBox6dMap {
 }
 
 impl MapFile for PointCloudMap {
-    const BACKEND: &'static str = "pointcloud";
+    const BACKEND: Backend = Backend::PointCloud;
 
     /// Writes the points as `[x, y, z]` triples (in the map's level order, not necessarily the
     /// order they were added in; the answers of the map do not depend on it).
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
         let points: Vec<[Real; 3]> = self.points().map(|p| [p.x, p.y, p.z]).collect();
-        write_map(writer, Self::BACKEND, self.counts(), &points)
+        write_map(writer, Self::BACKEND.name(), self.counts(), &points)
     }
 
     /// Reads the points and rebuilds the trees; a non-finite point is
     /// [`MapFileError::Decode`].
     fn load(reader: impl Read) -> Result<Self, MapFileError> {
-        let (_, points): (_, Vec<[Real; 3]>) = read_map(reader, Some(Self::BACKEND))?;
+        let (_, points): (_, Vec<[Real; 3]>) = read_map(reader, Some(Self::BACKEND.name()))?;
         let points: Vec<Point3> = points.into_iter().map(Point3::from).collect();
         PointCloudMap::from_points(&points).map_err(|e| MapFileError::Decode(e.to_string()))
     }
@@ -181,140 +180,6 @@ impl MemoryUsage for PointCloudMap {
     }
 }
 
-/// A map of any backend of this crate, as read by [`load_any`].
-///
-/// New backends add a variant here and an arm to each `match` below (the compiler lists them).
-#[derive(Debug)]
-#[non_exhaustive]
-pub enum AnyMap {
-    /// A [`PolygonMap`] (tag `polygon`).
-    Polygon(PolygonMap),
-    /// A [`BBox6dMap`] (tag `bbox6d`).
-    BBox6d(BBox6dMap),
-    /// A [`PointCloudMap`] (tag `pointcloud`).
-    PointCloud(PointCloudMap),
-    /// A [`TrimeshMap`] (tag `trimesh`).
-    Trimesh(TrimeshMap),
-    /// A [`RapierMap`] (tag `rapier`).
-    Rapier(RapierMap),
-}
-
-impl AnyMap {
-    /// The backend tag ([`MapFile::BACKEND`] of the held map).
-    pub fn backend(&self) -> &'static str {
-        match self {
-            AnyMap::Polygon(_) => PolygonMap::BACKEND,
-            AnyMap::BBox6d(_) => BBox6dMap::BACKEND,
-            AnyMap::PointCloud(_) => PointCloudMap::BACKEND,
-            AnyMap::Trimesh(_) => TrimeshMap::BACKEND,
-            AnyMap::Rapier(_) => RapierMap::BACKEND,
-        }
-    }
-
-    /// The heap bytes of the held map ([`MemoryUsage`]).
-    pub fn memory_bytes(&self) -> usize {
-        match self {
-            AnyMap::Polygon(m) => m.memory_bytes(),
-            AnyMap::BBox6d(m) => m.memory_bytes(),
-            AnyMap::PointCloud(m) => MemoryUsage::memory_bytes(m),
-            AnyMap::Trimesh(m) => m.memory_bytes(),
-            AnyMap::Rapier(m) => MemoryUsage::memory_bytes(m),
-        }
-    }
-
-    /// What the held map holds ([`MapFile::counts`]).
-    pub fn counts(&self) -> MapCounts {
-        match self {
-            AnyMap::Polygon(m) => m.counts(),
-            AnyMap::BBox6d(m) => m.counts(),
-            AnyMap::PointCloud(m) => m.counts(),
-            AnyMap::Trimesh(m) => m.counts(),
-            AnyMap::Rapier(m) => m.counts(),
-        }
-    }
-
-    /// Writes the held map with its own backend tag ([`MapFile::save`]).
-    ///
-    /// # Errors
-    /// As [`MapFile::save`].
-    pub fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        match self {
-            AnyMap::Polygon(m) => m.save(writer),
-            AnyMap::BBox6d(m) => m.save(writer),
-            AnyMap::PointCloud(m) => m.save(writer),
-            AnyMap::Trimesh(m) => m.save(writer),
-            AnyMap::Rapier(m) => m.save(writer),
-        }
-    }
-
-    /// The box of the held map's patches or points ([`Aabb::EMPTY`] for an empty map).
-    pub fn bounds(&self) -> Aabb {
-        match self {
-            AnyMap::Polygon(m) => m.bounds(),
-            AnyMap::BBox6d(m) => m.bounds(),
-            AnyMap::PointCloud(m) => m.bounds(),
-            AnyMap::Trimesh(m) => m.bounds(),
-            AnyMap::Rapier(m) => m.bounds(),
-        }
-    }
-
-    /// The patches of a patch map, in id order; `None` for a point-cloud map.
-    pub fn patches(&self) -> Option<&[Patch]> {
-        match self {
-            AnyMap::Polygon(m) => Some(m.patches()),
-            AnyMap::BBox6d(m) => Some(m.patches()),
-            AnyMap::PointCloud(_) => None,
-            AnyMap::Trimesh(m) => Some(m.patches()),
-            AnyMap::Rapier(m) => Some(m.patches()),
-        }
-    }
-}
-
-/// The four patch backends run the visitor (every capability of thesis Table 5.2); the
-/// point-cloud map gives it back.
-impl MaybePatchMap for AnyMap {
-    fn with_patch_map<'m, V: PatchMapVisitor<'m>>(&'m self, visitor: V) -> Result<V::Output, V> {
-        match self {
-            AnyMap::Polygon(m) => Ok(visitor.visit(m)),
-            AnyMap::BBox6d(m) => Ok(visitor.visit(m)),
-            AnyMap::Trimesh(m) => Ok(visitor.visit(m)),
-            AnyMap::Rapier(m) => Ok(visitor.visit(m)),
-            AnyMap::PointCloud(_) => Err(visitor),
-        }
-    }
-
-    fn backend_name(&self) -> &'static str {
-        self.backend()
-    }
-}
-
-/// Every backend answers the unspecific capsule query (with its own tolerance: the point-cloud
-/// map under its density assumption).
-impl UnspecificStepIntersector<CapsuleStep> for AnyMap {
-    fn is_step_free(&self, step: &CapsuleStep) -> bool {
-        match self {
-            AnyMap::Polygon(m) => m.is_step_free(step),
-            AnyMap::BBox6d(m) => m.is_step_free(step),
-            AnyMap::PointCloud(m) => m.is_step_free(step),
-            AnyMap::Trimesh(m) => m.is_step_free(step),
-            AnyMap::Rapier(m) => m.is_step_free(step),
-        }
-    }
-}
-
-/// Every backend answers the unspecific line query.
-impl UnspecificStepIntersector<LineStep> for AnyMap {
-    fn is_step_free(&self, step: &LineStep) -> bool {
-        match self {
-            AnyMap::Polygon(m) => m.is_step_free(step),
-            AnyMap::BBox6d(m) => m.is_step_free(step),
-            AnyMap::PointCloud(m) => m.is_step_free(step),
-            AnyMap::Trimesh(m) => m.is_step_free(step),
-            AnyMap::Rapier(m) => m.is_step_free(step),
-        }
-    }
-}
-
 /// Reads a map file of any backend this build knows, choosing the backend by the header's tag.
 ///
 /// # Errors
@@ -326,13 +191,15 @@ pub fn load_any(mut reader: impl Read) -> Result<AnyMap, MapFileError> {
     (&mut reader).take(HEADER_LEN as u64).read_to_end(&mut head)?;
     let header = read_header(&head[..])?;
     let whole = Read::chain(&head[..], reader);
-    match header.backend.as_str() {
-        PolygonMap::BACKEND => PolygonMap::load(whole).map(AnyMap::Polygon),
-        BBox6dMap::BACKEND => BBox6dMap::load(whole).map(AnyMap::BBox6d),
-        PointCloudMap::BACKEND => PointCloudMap::load(whole).map(AnyMap::PointCloud),
-        TrimeshMap::BACKEND => TrimeshMap::load(whole).map(AnyMap::Trimesh),
-        RapierMap::BACKEND => RapierMap::load(whole).map(AnyMap::Rapier),
-        _ => Err(MapFileError::UnknownBackend { found: header.backend }),
+    let Ok(backend) = header.backend.parse::<Backend>() else {
+        return Err(MapFileError::UnknownBackend { found: header.backend });
+    };
+    match backend {
+        Backend::Polygon => PolygonMap::load(whole).map(AnyMap::Polygon),
+        Backend::BBox6d => BBox6dMap::load(whole).map(AnyMap::BBox6d),
+        Backend::PointCloud => PointCloudMap::load(whole).map(AnyMap::PointCloud),
+        Backend::Trimesh => TrimeshMap::load(whole).map(AnyMap::Trimesh),
+        Backend::Rapier => RapierMap::load(whole).map(AnyMap::Rapier),
     }
 }
 

@@ -51,6 +51,7 @@ use rapier3d_f64::parry::query::DefaultQueryDispatcher;
 use rapier3d_f64::parry::shape::{TriMesh, TriMeshFlags};
 use rapier3d_f64::pipeline::{QueryFilter, QueryPipeline};
 
+use crate::Backend;
 use crate::mapfile::{MapCounts, MapFileError, read_map, write_map};
 use crate::persist::{MapFile, MemoryUsage, patch_counts, patches_memory_bytes};
 use crate::trimesh::{
@@ -327,16 +328,16 @@ impl SpecificStepIntersector<CapsuleStep> for RapierMap {
 }
 
 impl MapFile for RapierMap {
-    const BACKEND: &'static str = "rapier";
+    const BACKEND: Backend = Backend::Rapier;
 
     /// Writes the patch list (in id order).
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        write_map(writer, Self::BACKEND, self.counts(), &self.patches)
+        write_map(writer, Self::BACKEND.name(), self.counts(), &self.patches)
     }
 
     /// Reads the patch list and rebuilds the colliders and the broad phase.
     fn load(reader: impl Read) -> Result<Self, MapFileError> {
-        let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(Self::BACKEND))?;
+        let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(Self::BACKEND.name()))?;
         RapierMap::build(patches).map_err(|e| MapFileError::Decode(e.to_string()))
     }
 

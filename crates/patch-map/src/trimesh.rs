@@ -91,6 +91,7 @@ use patch_core::{
 };
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+use crate::Backend;
 use crate::mapfile::{MapCounts, MapFileError, read_map, write_map};
 use crate::persist::{MapFile, MemoryUsage, patch_counts, patches_memory_bytes};
 use crate::triangulate::{TriangulationError, triangulate_polygon};
@@ -938,16 +939,16 @@ impl<'de> Deserialize<'de> for TrimeshMap {
 }
 
 impl MapFile for TrimeshMap {
-    const BACKEND: &'static str = "trimesh";
+    const BACKEND: Backend = Backend::Trimesh;
 
     /// Writes the patch list (in id order; the mesh is not stored).
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        write_map(writer, Self::BACKEND, self.counts(), &self.patches)
+        write_map(writer, Self::BACKEND.name(), self.counts(), &self.patches)
     }
 
     /// Reads the patch list and rebuilds the mesh and its BVH (one mesh, `O(n log n)`).
     fn load(reader: impl Read) -> Result<Self, MapFileError> {
-        let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(Self::BACKEND))?;
+        let (_, patches): (_, Vec<Patch>) = read_map(reader, Some(Self::BACKEND.name()))?;
         TrimeshMap::build(patches).map_err(|e| MapFileError::Decode(e.to_string()))
     }
 
@@ -1217,7 +1218,7 @@ mod tests {
         assert_eq!(back.first_hit(&step), map.first_hit(&step));
         let any = load_any(&buf[..]).unwrap();
         assert!(matches!(any, AnyMap::Trimesh(_)));
-        assert_eq!(any.backend(), "trimesh");
+        assert_eq!(any.backend(), Backend::Trimesh);
         assert_eq!(any.patches(), Some(map.patches()));
         assert!(matches!(
             crate::RapierMap::load(&buf[..]),

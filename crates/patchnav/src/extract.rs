@@ -23,7 +23,8 @@
 //! | `peak_rss_kib`, `rss_after_load_kib` | `VmHWM` of `/proc/self/status` at the end and after reading (`null` elsewhere) |
 
 use crate::input::InputArgs;
-use crate::map::{BackendChoice, save_patches};
+use crate::map::save_patches;
+use crate::names;
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
@@ -32,6 +33,7 @@ use patch_core::triangulate::patch_triangles;
 use patch_core::{Isometry3, Patch, Point3, Real};
 use patch_extract::pipeline::{PipelineConfig, extract};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
+use patch_map::Backend;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
 use std::collections::HashMap;
@@ -82,8 +84,8 @@ pub struct ExtractArgs {
     #[arg(long, required_unless_present_any = ["export", "jsonl", "polygons"])]
     pub out: Option<PathBuf>,
     /// The backend of the map file.
-    #[arg(long, value_enum, default_value_t = BackendChoice::Bbox6d)]
-    pub backend: BackendChoice,
+    #[arg(long, value_parser = names::all::<Backend>(), default_value_t = Backend::BBox6d)]
+    pub backend: Backend,
     /// For `--backend pointcloud`: sample the patches every SPACING metres.
     #[arg(long)]
     pub spacing: Option<f64>,
@@ -479,7 +481,7 @@ mod tests {
         let args = ExtractArgs {
             scans: vec![scan],
             out: None,
-            backend: BackendChoice::Bbox6d,
+            backend: Backend::BBox6d,
             spacing: None,
             sensor: SensorPreset::RangeCamera,
             hybrid: false,

@@ -26,6 +26,7 @@ mod extract;
 mod info;
 mod input;
 mod map;
+mod names;
 mod plan;
 mod problem;
 mod progress;

@@ -15,21 +15,21 @@
 //! `cargo xtask bench roadmap` plans on maps built this way.
 
 use crate::input::InputArgs;
+use crate::names;
 use crate::progress::Progress;
 use crate::scene_map::{
     MapKind, MapSource, PcCleaning, ScanSetup, SceneSurfaces, Tessellation, extracted_patches_with,
     pc_points, scan_clouds,
 };
 use anyhow::{Context, Result, bail};
-use clap::{Args, Subcommand, ValueEnum};
-use patch_core::{FromPatches, Patch, PatchId, Point3};
+use clap::{Args, Subcommand};
+use patch_core::{Patch, PatchId, Point3};
 use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
 use patch_map::{
-    AnyMap, Attribution, BBox6dMap, MapFile, MemoryUsage, MeshToPatchesConfig, PointCloudMap,
-    PolygonMap, RapierMap, StepSampling, TrimeshMap, compare_maps, load_any,
-    planar_patches_from_mesh, sample_patch_points,
+    AnyMap, AnyMapError, Attribution, Backend, MeshToPatchesConfig, PointCloudMap, StepSampling,
+    compare_maps, load_any, planar_patches_from_mesh,
 };
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
@@ -51,28 +51,6 @@ pub enum MapCommand {
         /// A map file written by `patchnav map build`.
         file: PathBuf,
     },
-}
-
-/// The backends `map build` offers.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum BackendChoice {
-    /// Native polygons, no broad phase (the thesis's SimplePatchMap).
-    Polygon,
-    /// Patch boxes as 6D points in a k-d forest (the thesis's BoundingBox6DPatchMap).
-    Bbox6d,
-    /// Triangulated patches in one parry triangle mesh with a BVH.
-    Trimesh,
-    /// One collider per patch in a rapier query pipeline.
-    Rapier,
-    /// The points themselves, checked by the thesis's Algorithm 10.
-    Pointcloud,
-}
-
-impl BackendChoice {
-    /// The name on the command line.
-    pub fn name(self) -> String {
-        self.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default()
-    }
 }
 
 /// Arguments of `patchnav map build`.
@@ -140,8 +118,8 @@ pub struct BuildArgs {
     #[arg(long)]
     pub denoise: bool,
     /// The backend of the new map.
-    #[arg(long, value_enum)]
-    pub backend: BackendChoice,
+    #[arg(long, value_parser = names::all::<Backend>())]
+    pub backend: Backend,
     /// The map file to write (conventionally `.pmap`).
     #[arg(long)]
     pub out: PathBuf,
@@ -268,7 +246,7 @@ pub fn open_map(path: &Path) -> Result<AnyMap> {
     load_any(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))
 }
 
-fn save<M: MapFile + MemoryUsage>(map: &M, out: &Path) -> Result<(u64, usize)> {
+fn save(map: &AnyMap, out: &Path) -> Result<(u64, usize)> {
     let bytes = io::write_atomically(out, |w| {
         map.save(w).with_context(|| format!("writing {}", out.display()))
     })?;
@@ -365,21 +343,20 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
             save_patches(patches.clone(), backend, args.spacing, &args.out)
                 .with_context(|| label.clone())?
         }
-        (Source::Points(points), BackendChoice::Pointcloud) => {
+        (Source::Points(points), Backend::PointCloud) => {
             if args.spacing.is_some() {
                 bail!("--spacing applies to patch inputs; a point cloud is used as it is");
             }
-            save(&PointCloudMap::from_points(points)?, &args.out)?
+            save(&AnyMap::PointCloud(PointCloudMap::from_points(points)?), &args.out)?
         }
         (Source::Points(_), backend) => bail!(
-            "{label}: a point cloud has no patches; the {} backend needs a mesh or a patch map \
-             (or use --backend pointcloud)",
-            backend.name()
+            "{label}: a point cloud has no patches; the {backend} backend needs a mesh or a patch \
+             map (or use --backend pointcloud)"
         ),
     };
     spinner.finish_and_clear();
     progress.say(format!(
-        "wrote {} ({:?} backend, {bytes} bytes on disk, {memory} bytes in memory)",
+        "wrote {} ({} backend, {bytes} bytes on disk, {memory} bytes in memory)",
         args.out.display(),
         args.backend
     ));
@@ -390,24 +367,17 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
 /// map made from patches, which it needs); returns the bytes on disk and in memory.
 pub fn save_patches(
     patches: Vec<Patch>,
-    backend: BackendChoice,
+    backend: Backend,
     spacing: Option<f64>,
     out: &Path,
 ) -> Result<(u64, usize)> {
-    Ok(match backend {
-        BackendChoice::Polygon => save(&PolygonMap::from_patches(patches)?, out)?,
-        BackendChoice::Bbox6d => save(&BBox6dMap::from_patches(patches)?, out)?,
-        BackendChoice::Trimesh => save(&TrimeshMap::from_patches(patches)?, out)?,
-        BackendChoice::Rapier => save(&RapierMap::from_patches(patches)?, out)?,
-        BackendChoice::Pointcloud => match spacing {
-            Some(spacing) => {
-                save(&PointCloudMap::from_points(&sample_patch_points(&patches, spacing)?)?, out)?
-            }
-            None => bail!(
-                "the pointcloud backend needs a point cloud, or --spacing to sample the patches"
-            ),
-        },
-    })
+    let map = match AnyMap::from_patches(backend, patches, spacing) {
+        Err(AnyMapError::NeedsSpacing) => {
+            bail!("the pointcloud backend needs a point cloud, or --spacing to sample the patches")
+        }
+        map => map?,
+    };
+    save(&map, out)
 }
 
 /// `patchnav map compare`: the safety of TEST against TRUTH.
@@ -618,7 +588,7 @@ mod tests {
         let command = cli(&[&from_scans[..], &[out.to_str().unwrap()]].concat()).unwrap();
         run(&command, &Progress::new(true)).unwrap();
         let map = open_map(&out).unwrap();
-        assert_eq!(map.backend(), "polygon");
+        assert_eq!(map.backend(), Backend::Polygon);
         let scanned = map.patches().unwrap();
         assert!(scanned.len() >= 3, "floor and walls at least: {}", scanned.len());
         assert!(scanned.iter().all(|p| p.as_planar().is_some()), "planes only");
@@ -681,7 +651,7 @@ mod tests {
         let scene = scene_sim::lab(0).unwrap();
         let truth = crate::scene_map::patch_map(
             crate::scene_map::truth_patches(&scene).unwrap(),
-            crate::scene_map::PatchBackend::Bbox6d,
+            Backend::BBox6d,
         )
         .unwrap();
         let setup = ScanSetup { scans: 4, height: 0.5, step_deg: Some(2.0), seed: 0, noise: 1.0 };
@@ -698,8 +668,7 @@ mod tests {
         let mut seen = Vec::new();
         for kind in [MapKind::Planes, MapKind::Hybrid] {
             let patches = crate::scene_map::extracted_patches(&clouds, kind).unwrap().unwrap();
-            let map = crate::scene_map::patch_map(patches, crate::scene_map::PatchBackend::Bbox6d)
-                .unwrap();
+            let map = crate::scene_map::patch_map(patches, Backend::BBox6d).unwrap();
             let c = rate(&map);
             seen.push((kind, c.unsafe_rate().value, c.overcautious_rate().value));
         }

@@ -2,9 +2,10 @@
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
 //! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
 
+use crate::names;
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
 use roadmap::{
@@ -13,57 +14,6 @@ use roadmap::{
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The planners `plan` offers.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum PlannerChoice {
-    /// Rapidly-exploring random tree (thesis Algorithm 13).
-    Rrt,
-    /// Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours.
-    Prm,
-    /// PRM* (Karaman and Frazzoli 2011): ⌈e(1 + 1/3) ln n⌉ nearest neighbours, cycles kept.
-    PrmStar,
-    /// Lazy PRM (Bohlin and Kavraki 2000): six nearest neighbours, edges checked only when a
-    /// shortest path uses them.
-    LazyPrm,
-    /// RRT* (Karaman and Frazzoli 2011): ⌈2e ln n⌉ nearest candidates for parent and rewiring.
-    RrtStar,
-    /// RRT-Connect (Kuffner and LaValle 2000), one goal tree per goal joined to the start tree.
-    RrtConnect,
-    /// Evasion RRT (thesis Algorithm 11, repaired): needs a patch map (specific hits).
-    EvasionRrt,
-    /// Medial-axis PRM (thesis Algorithm 12): needs a patch map (proximity queries).
-    MaPrm,
-    /// Medial-axis RRT (thesis §5.5.2): needs a patch map (proximity queries).
-    MaRrt,
-    /// PRM on valid samples with cycles: Algorithm 14 with each sample checked before it is
-    /// added and edges to all six neighbours (as OMPL's PRM); not in the thesis.
-    PrmValid,
-}
-
-impl PlannerChoice {
-    /// The name on the command line (`rrt`, `evasion-rrt`, ...), which is also the name the
-    /// planner reports.
-    pub fn cli_name(self) -> String {
-        self.to_possible_value().map(|v| v.get_name().to_owned()).unwrap_or_default()
-    }
-
-    /// The planner of the `roadmap` crate.
-    pub fn kind(self) -> PlannerKind {
-        match self {
-            PlannerChoice::Rrt => PlannerKind::Rrt,
-            PlannerChoice::Prm => PlannerKind::Prm,
-            PlannerChoice::PrmStar => PlannerKind::PrmStar,
-            PlannerChoice::LazyPrm => PlannerKind::LazyPrm,
-            PlannerChoice::RrtStar => PlannerKind::RrtStar,
-            PlannerChoice::RrtConnect => PlannerKind::RrtConnect,
-            PlannerChoice::EvasionRrt => PlannerKind::EvasionRrt,
-            PlannerChoice::MaPrm => PlannerKind::MaPrm,
-            PlannerChoice::MaRrt => PlannerKind::MaRrt,
-            PlannerChoice::PrmValid => PlannerKind::PrmValid,
-        }
-    }
-}
 
 /// Arguments of `patchnav plan`: either one run on a map file (`MAP --start --goal --radius`),
 /// or the runs of a shared planning problem (`--problem P.json --backend B --mode M`).
@@ -82,8 +32,8 @@ pub struct PlanArgs {
     #[arg(long, default_value_t = 0.5, conflicts_with = "problem")]
     pub goal_tolerance: Real,
     /// The planner.
-    #[arg(long, value_enum, default_value_t = PlannerChoice::Rrt)]
-    pub planner: PlannerChoice,
+    #[arg(long, value_parser = names::all::<PlannerKind>(), default_value_t = PlannerKind::Rrt)]
+    pub planner: PlannerKind,
     /// Robot radius (the capsule radius of every step), metres.
     #[arg(long, required_unless_present = "problem", conflicts_with = "problem")]
     pub radius: Option<Real>,
@@ -220,18 +170,18 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
-/// The planner `choice` on `map` ([`roadmap::named_planner_on`]). Every planner tests, after
+/// The planner `kind` on `map` ([`roadmap::named_planner_on`]). Every planner tests, after
 /// each added vertex, whether the goal is directly reachable by one free capsule step (the
 /// thesis's §6.2.3 variant), so their results compare. The Evasion RRT and the medial-axis
 /// planners run on the concrete backend of `map`: they need specific step hits and proximity
 /// queries, which a point-cloud map cannot give (thesis Table 5.2).
 pub(crate) fn make_planner(
-    choice: PlannerChoice,
+    kind: PlannerKind,
     map: &AnyMap,
     space: PlanningSpace,
     seed: u64,
 ) -> Result<Box<dyn Planner + '_>> {
-    Ok(named_planner_on(choice.kind(), map, space, seed)?)
+    Ok(named_planner_on(kind, map, space, seed)?)
 }
 
 /// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).

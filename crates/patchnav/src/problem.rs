@@ -9,34 +9,19 @@
 //! * `roi`: reach every goal from the start with one growing tree or roadmap (the thesis's
 //!   preliminary experiment, §5.5.3), stopping when all are reached or after `iterations`.
 
-use crate::plan::{PlannerChoice, make_planner};
+use crate::names;
+use crate::plan::make_planner;
 use crate::progress::Progress;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use patch_core::{FromPatches, Patch, Point3, Real};
-use patch_map::{
-    AnyMap, BBox6dMap, MeshToPatchesConfig, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
-    planar_patches_from_mesh, sample_patch_points,
+use patch_core::{Patch, Point3, Real};
+use patch_map::{AnyMap, Backend, MeshToPatchesConfig, planar_patches_from_mesh};
+use roadmap::{
+    AnyOf, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlannerStatus, Problem,
 };
-use roadmap::{AnyOf, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, Problem};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The backends a problem's mesh can be loaded into.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ProblemBackend {
-    /// Native polygons, no broad phase.
-    Polygon,
-    /// 6D bounding-box k-d forest.
-    Bbox6d,
-    /// One parry triangle mesh.
-    Trimesh,
-    /// One rapier collider per patch.
-    Rapier,
-    /// The mesh's surfaces sampled into a point-cloud map.
-    Pointcloud,
-}
 
 /// What the runs of a problem do.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -57,8 +42,8 @@ pub struct ProblemArgs {
     #[arg(long)]
     pub problem: Option<PathBuf>,
     /// The backend the problem's mesh is loaded into.
-    #[arg(long, value_enum, default_value_t = ProblemBackend::Bbox6d, requires = "problem")]
-    pub backend: ProblemBackend,
+    #[arg(long, value_parser = names::all::<Backend>(), default_value_t = Backend::BBox6d, requires = "problem")]
+    pub backend: Backend,
     /// What each run does.
     #[arg(long, value_enum, default_value_t = Mode::Roi, requires = "problem")]
     pub mode: Mode,
@@ -86,21 +71,11 @@ pub(crate) fn read_patches(p: &ProblemFile) -> Result<Vec<Patch>> {
 pub(crate) fn map_from_patches(
     p: &ProblemFile,
     patches: Vec<Patch>,
-    backend: ProblemBackend,
+    backend: Backend,
     sample_spacing: Option<Real>,
 ) -> Result<AnyMap> {
-    Ok(match backend {
-        ProblemBackend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
-        ProblemBackend::Bbox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
-        ProblemBackend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
-        ProblemBackend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
-        ProblemBackend::Pointcloud => {
-            let spacing = sample_spacing.unwrap_or(p.robot_radius / 4.0);
-            AnyMap::PointCloud(PointCloudMap::from_points(&sample_patch_points(
-                &patches, spacing,
-            )?)?)
-        }
-    })
+    let spacing = sample_spacing.unwrap_or(p.robot_radius / 4.0);
+    Ok(AnyMap::from_patches(backend, patches, Some(spacing))?)
 }
 
 /// One timed `solve`: in `explore` mode exactly `iterations` iterations, otherwise until every
@@ -121,12 +96,12 @@ pub(crate) fn solve_timed(
 }
 
 /// The keys every result row starts with (the results format of `FORMAT.md`).
-fn row_head(p: &ProblemFile, planner: &str, backend: &str, mode: Mode, seed: u64) -> Value {
+fn row_head(p: &ProblemFile, planner: &str, backend: Backend, mode: Mode, seed: u64) -> Value {
     json!({
         "kind": "planning",
         "tool": concat!("patchnav-", env!("CARGO_PKG_VERSION")),
         "planner": planner,
-        "backend": backend,
+        "backend": backend.name(),
         "problem": p.name,
         "mode": mode_name(mode),
         "seed": seed,
@@ -141,13 +116,13 @@ fn mode_name(mode: Mode) -> String {
 /// this query): recorded with the reason, as the results format asks.
 pub(crate) fn skipped_row(
     p: &ProblemFile,
-    choice: PlannerChoice,
-    backend: &str,
+    kind: PlannerKind,
+    backend: Backend,
     mode: Mode,
     seed: u64,
     reason: &anyhow::Error,
 ) -> Value {
-    let mut row = row_head(p, &choice.cli_name(), backend, mode, seed);
+    let mut row = row_head(p, kind.name(), backend, mode, seed);
     row["skipped"] = json!(format!("{reason:#}"));
     row
 }
@@ -156,7 +131,7 @@ pub(crate) fn skipped_row(
 pub(crate) fn run_row(
     p: &ProblemFile,
     planner: &dyn Planner,
-    backend: &str,
+    backend: Backend,
     mode: Mode,
     seed: u64,
     (status, time_s): (PlannerStatus, Real),
@@ -195,7 +170,7 @@ pub(crate) fn run_row(
 }
 
 /// Runs every seed (and in `solve` mode every goal) of the problem; prints one JSON line each.
-pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Result<()> {
+pub fn run(args: &ProblemArgs, kind: PlannerKind, progress: &Progress) -> Result<()> {
     let path = args.problem.as_ref().context("--problem is missing")?;
     let p = read_problem(path)?;
     let map = map_from_patches(&p, read_patches(&p)?, args.backend, args.sample_spacing)?;
@@ -209,7 +184,7 @@ pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Re
     for &seed in &p.seeds {
         for (goal_index, goals) in &queries {
             let problem = p.query(goals);
-            let row = match make_planner(choice, &map, space, seed) {
+            let row = match make_planner(kind, &map, space, seed) {
                 Ok(mut planner) => {
                     let outcome = solve_timed(planner.as_mut(), &problem, args.mode, p.iterations);
                     let paths: Vec<Option<Vec<Point3>>> =
@@ -228,7 +203,7 @@ pub fn run(args: &ProblemArgs, choice: PlannerChoice, progress: &Progress) -> Re
                     }
                     row
                 }
-                Err(reason) => skipped_row(&p, choice, map.backend(), args.mode, seed, &reason),
+                Err(reason) => skipped_row(&p, kind, map.backend(), args.mode, seed, &reason),
             };
             // A closed pipe (`| head`) ends the run quietly instead of panicking in println!.
             let written = bar.suspend(|| {

@@ -34,7 +34,7 @@
 //! | `plan.radius` | `0.3` | robot radius, metres |
 //! | `plan.step` | `1.0` | longest RRT edge, metres |
 //! | `plan.goal_tolerance` | `0.5` | how close a vertex must come to a goal, metres |
-//! | `plan.planners` | `["rrt", "prm"]` | any planner of `patchnav plan` (`rrt prm prm-star lazy-prm rrt-star rrt-connect evasion-rrt ma-prm ma-rrt`) |
+//! | `plan.planners` | `["rrt", "prm"]` | any planner of `patchnav plan` (`rrt ma-rrt evasion-rrt prm ma-prm rrt-connect prm-star lazy-prm rrt-star prm-valid`) |
 //! | `plan.seeds` | `[1]` | seeds; every planner runs once per seed on every map |
 //! | `plan.max_iterations` | `10000` | iteration budget of a run (it stops once every goal is reached) |
 //! | `tof.range`, `tof.amplitude`, `tof.meta` | — (required in `[tof]`) | a 16-bit PNG pair and its JSON sidecar, as `patchnav tof filter` reads |

@@ -29,7 +29,7 @@ use patch_extract::{
     grow_trimeshes,
 };
 use patch_map::triangulate::triangulate_polygon;
-use patch_map::{AnyMap, BBox6dMap, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
+use patch_map::{AnyMap, Backend, PointCloudMap, PolygonMap};
 use pointcloud::{BeamModel, PointCloud};
 use scene_sim::{Alrf, AlrfConfig, RangeSensor, Scene};
 use std::collections::HashMap;
@@ -66,32 +66,6 @@ impl MapKind {
 impl fmt::Display for MapKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-/// The backend a patch map (planes, hybrid, trimesh) is loaded into; the `pc` map is always a
-/// [`PointCloudMap`] (thesis §6.1: Algorithm 10, spec §7.12).
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum PatchBackend {
-    /// One parry triangle mesh with a BVH (the role of the thesis's Bullet maps).
-    Trimesh,
-    /// One rapier collider per patch (Bullet's collision world).
-    Rapier,
-    /// The 6D bounding-box k-d forest.
-    Bbox6d,
-    /// Native polygons, no broad phase.
-    Polygon,
-}
-
-impl PatchBackend {
-    /// The name on the command line (`trimesh`, `rapier`, `bbox6d`, `polygon`).
-    pub fn name(self) -> &'static str {
-        match self {
-            PatchBackend::Trimesh => "trimesh",
-            PatchBackend::Rapier => "rapier",
-            PatchBackend::Bbox6d => "bbox6d",
-            PatchBackend::Polygon => "polygon",
-        }
     }
 }
 
@@ -249,8 +223,8 @@ impl BuiltMap {
     }
 }
 
-/// Builds the map of `kind` for `scene`: patch maps in `backend`, the `pc` map from `scans`
-/// cleaned as `pc` says.
+/// Builds the map of `kind` for `scene`: patch maps in `backend` (a patch backend), the `pc` map
+/// (always a [`PointCloudMap`]: thesis §6.1, Algorithm 10) from `scans` cleaned as `pc` says.
 ///
 /// # Errors
 /// As [`SceneSurfaces::of`], a backend refusing the patches or points, or no scan pose found.
@@ -259,7 +233,7 @@ pub fn build_map(
     scene: &Scene,
     surfaces: &SceneSurfaces,
     kind: MapKind,
-    backend: PatchBackend,
+    backend: Backend,
     t: &Tessellation,
     scans: &ScanSetup,
     source: MapSource,
@@ -313,14 +287,10 @@ pub fn build_map(
     Ok(built)
 }
 
-/// Loads `patches` into `backend`.
-pub fn patch_map(patches: Vec<Patch>, backend: PatchBackend) -> Result<AnyMap> {
-    Ok(match backend {
-        PatchBackend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
-        PatchBackend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
-        PatchBackend::Bbox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
-        PatchBackend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
-    })
+/// Loads `patches` into `backend`, a patch backend ([`Backend::holds_patches`]; the
+/// point-cloud backend is [`patch_map::AnyMapError::NeedsSpacing`]).
+pub fn patch_map(patches: Vec<Patch>, backend: Backend) -> Result<AnyMap> {
+    Ok(AnyMap::from_patches(backend, patches, None)?)
 }
 
 /// How a pc map is made from organised scans. `Default`: nothing, the raw points (the

@@ -57,7 +57,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtConnect<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for RrtConnect<'_, M> {
     fn name(&self) -> &'static str {
-        "rrt-connect"
+        crate::PlannerKind::RrtConnect.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

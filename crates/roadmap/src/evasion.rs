@@ -124,7 +124,7 @@ impl<'m, M: SpecificStepIntersector<CapsuleStep> + ?Sized> EvasionRrt<'m, M> {
 
 impl<M: SpecificStepIntersector<CapsuleStep> + ?Sized> Planner for EvasionRrt<'_, M> {
     fn name(&self) -> &'static str {
-        "evasion-rrt"
+        crate::PlannerKind::EvasionRrt.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

@@ -261,7 +261,7 @@ impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Ma
 
 impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for MaPrm<'_, M> {
     fn name(&self) -> &'static str {
-        "ma-prm"
+        crate::PlannerKind::MaPrm.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {
@@ -347,7 +347,7 @@ impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Ma
 
 impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for MaRrt<'_, M> {
     fn name(&self) -> &'static str {
-        "ma-rrt"
+        crate::PlannerKind::MaRrt.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

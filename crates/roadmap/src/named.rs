@@ -4,9 +4,10 @@
 //! ([`RrtConfig::lesum`]) and the PRMs the thesis's six neighbours (Algorithm 14).
 //!
 //! Two planners need more of a map than step tests (thesis Table 5.2): the Evasion RRT needs
-//! specific step hits, the medial-axis planners need proximity queries. [`named_planner`] builds
-//! the others on any map that tests steps; [`named_patch_planner`] builds all ten on a map with
-//! every capability.
+//! specific step hits, the medial-axis planners need proximity queries ([`PlannerKind::needs`],
+//! the one place that decides it; [`PlannerKind::runs_on`] asks a map chosen at run time).
+//! [`named_planner`] builds the others on any map that tests steps; [`named_patch_planner`]
+//! builds all ten on a map with every capability.
 //!
 //! ```
 //! use patch_core::{Aabb, BruteForceMap, Point3};
@@ -130,7 +131,47 @@ impl PlannerKind {
         }
     }
 
-    /// The capability beyond step tests this planner needs, if any.
+    /// One line for help texts.
+    pub const fn description(self) -> &'static str {
+        match self {
+            PlannerKind::Rrt => "Rapidly-exploring random tree (thesis Algorithm 13)",
+            PlannerKind::MaRrt => {
+                "Medial-axis RRT (thesis §5.5.2): needs proximity queries (a patch map)"
+            }
+            PlannerKind::EvasionRrt => {
+                "Evasion RRT (thesis Algorithm 11, repaired): needs specific step hits (a patch map)"
+            }
+            PlannerKind::Prm => {
+                "Probabilistic roadmap (thesis Algorithm 14), six nearest neighbours"
+            }
+            PlannerKind::MaPrm => {
+                "Medial-axis PRM (thesis Algorithm 12): needs proximity queries (a patch map)"
+            }
+            PlannerKind::RrtConnect => {
+                "RRT-Connect (Kuffner and LaValle 2000), one goal tree per goal joined to the \
+                 start tree"
+            }
+            PlannerKind::PrmStar => {
+                "PRM* (Karaman and Frazzoli 2011): ⌈e(1 + 1/3) ln n⌉ nearest neighbours, cycles \
+                 kept"
+            }
+            PlannerKind::LazyPrm => {
+                "Lazy PRM (Bohlin and Kavraki 2000): six nearest neighbours, edges checked only \
+                 when a shortest path uses them"
+            }
+            PlannerKind::RrtStar => {
+                "RRT* (Karaman and Frazzoli 2011): ⌈2e ln n⌉ nearest candidates for parent and \
+                 rewiring"
+            }
+            PlannerKind::PrmValid => {
+                "PRM on valid samples with cycles: Algorithm 14 with each sample checked before \
+                 it is added and edges to all six neighbours (as OMPL's PRM); not in the thesis"
+            }
+        }
+    }
+
+    /// The capability beyond step tests this planner needs, if any: the one place that decides
+    /// what a map must offer a planner.
     pub const fn needs(self) -> Option<MapCapability> {
         match self {
             PlannerKind::EvasionRrt => Some(MapCapability::SpecificHits),
@@ -143,6 +184,32 @@ impl PlannerKind {
             | PlannerKind::PrmValid
             | PlannerKind::RrtConnect => None,
         }
+    }
+
+    /// Whether `map` offers what this planner [`needs`](Self::needs).
+    pub fn runs_on<M: MaybePatchMap + ?Sized>(self, map: &M) -> bool {
+        self.needs().is_none_or(|capability| capability.offered_by(map))
+    }
+}
+
+impl MapCapability {
+    /// Whether `map` offers this capability: a map that holds patches offers both
+    /// ([`MaybePatchMap::with_patch_map`] runs its visitor on a map with every capability).
+    pub fn offered_by<M: MaybePatchMap + ?Sized>(self, map: &M) -> bool {
+        map.with_patch_map(Offers).is_ok()
+    }
+}
+
+/// The visitor of [`MapCapability::offered_by`]: it only has to run.
+struct Offers;
+
+impl<'m> PatchMapVisitor<'m> for Offers {
+    type Output = ();
+
+    fn visit<M>(self, _map: &'m M) -> Self::Output
+    where
+        M: ProximityQuery + SpecificStepIntersector<CapsuleStep>,
+    {
     }
 }
 
@@ -323,6 +390,31 @@ mod tests {
     }
 
     #[test]
+    fn every_name_round_trips_and_unknown_names_list_all_of_them() {
+        let mut names: Vec<&str> = PlannerKind::ALL.iter().map(|k| k.name()).collect();
+        for kind in PlannerKind::ALL {
+            assert_eq!(kind.to_string().parse::<PlannerKind>(), Ok(kind));
+            let d = kind.description();
+            assert!(!d.is_empty() && !d.contains('\n') && !d.contains("  "), "{kind}: {d}");
+            // The help text states the need that `needs` decides.
+            assert_eq!(d.contains("needs"), kind.needs().is_some(), "{kind}: {d}");
+        }
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), PlannerKind::ALL.len(), "names are distinct");
+        for bad in ["", "RRT", "rrt ", "astar", "prm_star"] {
+            match bad.parse::<PlannerKind>() {
+                Err(e @ NamedPlannerError::Unknown { .. }) => {
+                    let text = e.to_string();
+                    assert!(text.contains(&format!("`{bad}`")), "{text}");
+                    assert!(PlannerKind::ALL.iter().all(|k| text.contains(k.name())), "{text}");
+                }
+                other => panic!("{bad:?}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
     fn needy_planners_are_refused_on_plain_maps_and_all_solve_on_patch_maps() {
         let map = BruteForceMap::new();
         let problem = Problem {
@@ -394,6 +486,11 @@ mod tests {
                 }
                 (other, needs) => panic!("{kind}: {:?} with needs {needs:?}", other.err()),
             }
+            assert!(kind.runs_on(&patches), "{kind}");
+            assert_eq!(kind.runs_on(&points), kind.needs().is_none(), "{kind}");
+        }
+        for capability in [MapCapability::SpecificHits, MapCapability::Proximity] {
+            assert!(capability.offered_by(&patches) && !capability.offered_by(&points));
         }
     }
 }

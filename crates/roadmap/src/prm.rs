@@ -154,12 +154,15 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
 }
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> {
+    /// The name of the [`PlannerKind`](crate::PlannerKind) this configuration is, or
+    /// `lazy-prm-star`, which has none.
     fn name(&self) -> &'static str {
+        use crate::PlannerKind as K;
         match (self.lazy, self.config.star, self.config.valid_samples || self.config.cycles) {
-            (false, false, false) => "prm",
-            (false, false, true) => "prm-valid",
-            (false, true, _) => "prm-star",
-            (true, false, _) => "lazy-prm",
+            (false, false, false) => K::Prm.name(),
+            (false, false, true) => K::PrmValid.name(),
+            (false, true, _) => K::PrmStar.name(),
+            (true, false, _) => K::LazyPrm.name(),
             (true, true, _) => "lazy-prm-star",
         }
     }

@@ -108,7 +108,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Rrt<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> {
     fn name(&self) -> &'static str {
-        "rrt"
+        crate::PlannerKind::Rrt.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

@@ -133,7 +133,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtStar<'m, M> {
 
 impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for RrtStar<'_, M> {
     fn name(&self) -> &'static str {
-        "rrt-star"
+        crate::PlannerKind::RrtStar.name()
     }
 
     fn solve(&mut self, problem: &Problem, stop: &mut dyn Termination) -> PlannerStatus {

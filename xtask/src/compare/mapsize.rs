@@ -6,6 +6,7 @@
 use super::planning::{lab_dir, lab_scans};
 use super::{Env, arg, json_lines, num, ratio};
 use anyhow::{Context, Result, bail};
+use patch_map::Backend;
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -48,10 +49,10 @@ pub(crate) fn run(env: &Env, poses: usize) -> Result<(Vec<Value>, String)> {
     }
     // (label, extract options) — one extraction per map, its own timing row
     let ours: [(&str, &[&str]); 4] = [
-        ("planes, polygon backend", &["--backend", "polygon"]),
-        ("planes, bbox6d backend", &["--backend", "bbox6d"]),
-        ("planes, trimesh backend", &["--backend", "trimesh"]),
-        ("hybrid, polygon backend", &["--backend", "polygon", "--hybrid"]),
+        ("planes, polygon backend", &["--backend", Backend::Polygon.name()]),
+        ("planes, bbox6d backend", &["--backend", Backend::BBox6d.name()]),
+        ("planes, trimesh backend", &["--backend", Backend::Trimesh.name()]),
+        ("hybrid, polygon backend", &["--backend", Backend::Polygon.name(), "--hybrid"]),
     ];
     for (i, (label, options)) in ours.iter().enumerate() {
         eprintln!("mapsize: ours, {label}");
@@ -91,7 +92,7 @@ pub(crate) fn run(env: &Env, poses: usize) -> Result<(Vec<Value>, String)> {
         ]
         .map(str::to_owned)
         .into_iter()
-        .chain(["--backend".into(), "pointcloud".into(), "--out".into(), arg(&pc)])
+        .chain(["--backend".into(), Backend::PointCloud.to_string(), "--out".into(), arg(&pc)])
         .collect::<Vec<_>>(),
     )?;
     let wall = t.elapsed().as_secs_f64();

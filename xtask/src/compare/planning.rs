@@ -13,6 +13,8 @@
 
 use super::{Env, arg, json_lines, median, num, ratio};
 use anyhow::{Context, Result};
+use patch_map::Backend;
+use roadmap::PlannerKind;
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -24,19 +26,19 @@ const SOLVE_ITERATIONS: u64 = 20_000;
 /// Wall-clock cap of one OMPL run, seconds (a safety net; no run should reach it).
 const TIME_LIMIT_S: f64 = 30.0;
 /// Our backends: two patch maps and the same triangles.
-const OUR_BACKENDS: [&str; 3] = ["polygon", "bbox6d", "trimesh"];
+const OUR_BACKENDS: [Backend; 3] = [Backend::Polygon, Backend::BBox6d, Backend::Trimesh];
 /// (common planner name, OMPL program's planner name, our planners run against it). The
 /// first of ours has the common name; a variant's side is labelled `ours/{backend} {variant}`.
 /// PRM runs twice on our side: the thesis's Algorithm 14 (`prm`: unchecked samples, a forest)
 /// and `prm-valid` (samples checked, edges to all six neighbours: the roadmap OMPL's PRM builds).
-const PLANNERS: [(&str, &str, &[&str]); 3] = [
-    ("rrt", "rrt", &["rrt"]),
-    ("rrt-connect", "rrtconnect", &["rrt-connect"]),
-    ("prm", "prm", &["prm", "prm-valid"]),
+const PLANNERS: [(PlannerKind, &str, &[PlannerKind]); 3] = [
+    (PlannerKind::Rrt, "rrt", &[PlannerKind::Rrt]),
+    (PlannerKind::RrtConnect, "rrtconnect", &[PlannerKind::RrtConnect]),
+    (PlannerKind::Prm, "prm", &[PlannerKind::Prm, PlannerKind::PrmValid]),
 ];
 
 /// The side label of our planner `variant` of the common planner `common` on `backend`.
-fn our_side(backend: &str, common: &str, variant: &str) -> String {
+fn our_side(backend: Backend, common: PlannerKind, variant: PlannerKind) -> String {
     if variant == common { format!("ours/{backend}") } else { format!("ours/{backend} {variant}") }
 }
 const MODES: [&str; 3] = ["explore", "solve", "roi"];
@@ -125,7 +127,7 @@ pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
         for mode in MODES {
             let problem = write_problem(env, name, mode, seeds)?;
             for (ours, theirs, variants) in PLANNERS {
-                if mode == "explore" && ours == "rrt-connect" {
+                if mode == "explore" && ours == PlannerKind::RrtConnect {
                     continue; // two trees and a goal: no explore mode
                 }
                 eprintln!("planning: {name} {mode} {ours}");
@@ -139,12 +141,12 @@ pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
                     TIME_LIMIT_S.to_string(),
                 ];
                 rows.extend(tagged(json_lines(&omplx, &a), STOCK, name, mode, ours));
-                if mode != "explore" && ours != "rrt-connect" {
+                if mode != "explore" && ours != PlannerKind::RrtConnect {
                     let mut a = a.to_vec();
                     a.push("--direct-goal".into());
                     rows.extend(tagged(json_lines(&omplx, &a), DIRECT, name, mode, ours));
                 }
-                for variant in variants {
+                for &variant in variants {
                     for backend in OUR_BACKENDS {
                         let a = [
                             "--quiet",
@@ -152,9 +154,9 @@ pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
                             "--problem",
                             &arg(&problem),
                             "--backend",
-                            backend,
+                            backend.name(),
                             "--planner",
-                            variant,
+                            variant.name(),
                             "--mode",
                             mode,
                         ]
@@ -176,7 +178,7 @@ fn tagged(
     side: &str,
     problem: &str,
     mode: &str,
-    planner: &str,
+    planner: PlannerKind,
 ) -> Vec<Value> {
     let rows = result.unwrap_or_else(|e| {
         vec![json!({"kind": "planning", "skipped": format!("{e:#}"), "problem": problem, "mode": mode})]
@@ -184,7 +186,7 @@ fn tagged(
     rows.into_iter()
         .map(|mut r| {
             r["side"] = json!(side);
-            r["planner_common"] = json!(planner);
+            r["planner_common"] = json!(planner.name());
             r
         })
         .collect()
@@ -234,7 +236,7 @@ fn table(rows: &[Value]) -> String {
                         .filter(|r| {
                             r["problem"] == json!(problem)
                                 && r["mode"] == json!(mode)
-                                && r["planner_common"] == json!(planner)
+                                && r["planner_common"] == json!(planner.name())
                                 && r["side"] == json!(side)
                         })
                         .collect()
@@ -251,8 +253,8 @@ fn table(rows: &[Value]) -> String {
                         .into_iter()
                         .filter(|s| *s == STOCK || reference == DIRECT)
                         .map(str::to_owned)
-                        .chain(variants.iter().flat_map(|v| {
-                            OUR_BACKENDS.iter().map(move |b| our_side(b, planner, v))
+                        .chain(variants.iter().flat_map(|&v| {
+                            OUR_BACKENDS.iter().map(move |&b| our_side(b, planner, v))
                         }));
                 for side in sides {
                     let s = stats(&group(&side));
@@ -311,8 +313,9 @@ mod tests {
 
     #[test]
     fn variants_get_their_own_side_and_the_common_planner_keeps_the_plain_label() {
-        assert_eq!(our_side("trimesh", "prm", "prm"), "ours/trimesh");
-        assert_eq!(our_side("trimesh", "prm", "prm-valid"), "ours/trimesh prm-valid");
+        let (prm, valid) = (PlannerKind::Prm, PlannerKind::PrmValid);
+        assert_eq!(our_side(Backend::Trimesh, prm, prm), "ours/trimesh");
+        assert_eq!(our_side(Backend::Trimesh, prm, valid), "ours/trimesh prm-valid");
         let rows: Vec<Value> = ["ompl+fcl", "ours/polygon", "ours/polygon prm-valid"]
             .iter()
             .map(|side| {

@@ -8,6 +8,8 @@
 //! bound.
 
 use super::{BACKENDS, Matrix, PLANNERS, quantile, sig3, time_text};
+use patch_map::Backend;
+use roadmap::PlannerKind;
 use roadmap::thesis::{FIG_6_4_PATCH_MAPS_BELOW_S, FIG_6_4_SLOW_MAPS_ABOVE_S, LAB_MAPS};
 use std::fmt::Write as _;
 
@@ -53,7 +55,7 @@ pub(super) fn lab_table(m: &Matrix) -> String {
     }
     let _ = writeln!(out, "\n{rule}");
     for (p, label) in PLANNERS {
-        if !BACKENDS.iter().any(|(b, _)| m.solved("lab", b, p).is_some()) {
+        if !BACKENDS.iter().any(|&(b, _)| m.solved("lab", b, p).is_some()) {
             continue;
         }
         for (k, metric) in CHECKPOINTS {
@@ -62,8 +64,9 @@ pub(super) fn lab_table(m: &Matrix) -> String {
                 let text = match quartile_text(&m.values("lab", b, p, metric)) {
                     Some((med, text)) => {
                         // The exact map is the thesis's hybrid; its point-cloud map plays pc.
-                        let kind = if b == "pointcloud" { "pc" } else { "hybrid" };
-                        let bound = (p == "rrt" && k == 500).then(|| bound_text(kind, med));
+                        let kind = if b == Backend::PointCloud { "pc" } else { "hybrid" };
+                        let bound =
+                            (p == PlannerKind::Rrt && k == 500).then(|| bound_text(kind, med));
                         format!("{text}{}", bound.unwrap_or_default())
                     }
                     None => "–".into(),
@@ -108,7 +111,7 @@ pub(super) fn lab_scans_section(m: &Matrix) -> String {
     let _ = write!(o, "| planner | map | K |");
     let mut rule = String::from("|---|---|---|");
     for (b, thesis) in BACKENDS {
-        if b == "rapier" {
+        if b == Backend::Rapier {
             let _ = write!(o, " {b} ({thesis}) |");
         } else {
             let _ = write!(o, " {b} |");
@@ -119,7 +122,7 @@ pub(super) fn lab_scans_section(m: &Matrix) -> String {
     for (p, label) in PLANNERS {
         for kind in LAB_MAPS {
             let scene = scans_scene(kind);
-            if !BACKENDS.iter().any(|(b, _)| m.solved(&scene, b, p).is_some()) {
+            if !BACKENDS.iter().any(|&(b, _)| m.solved(&scene, b, p).is_some()) {
                 continue;
             }
             for (k, metric) in CHECKPOINTS {
@@ -127,7 +130,8 @@ pub(super) fn lab_scans_section(m: &Matrix) -> String {
                 for (b, _) in BACKENDS {
                     let text = match quartile_text(&m.values(&scene, b, p, metric)) {
                         Some((med, text)) => {
-                            let bound = (p == "rrt" && k == 500).then(|| bound_text(kind, med));
+                            let bound =
+                                (p == PlannerKind::Rrt && k == 500).then(|| bound_text(kind, med));
                             format!("{text}{}", bound.unwrap_or_default())
                         }
                         None => "–".into(),
@@ -146,17 +150,19 @@ pub(super) fn lab_scans_section(m: &Matrix) -> String {
 /// slower" than planes and hybrid) on our RRT medians at K = 500: trimesh / planes per patch
 /// backend, and pc / planes against the planes map in rapier (the thesis's Bullet).
 fn slow_fast_line(m: &Matrix) -> String {
-    let med = |kind: &str, b: &str| {
-        quantile(&m.values(&scans_scene(kind), b, "rrt", "time_k500"), 0.5).filter(|v| *v > 0.0)
+    let med = |kind: &str, b: Backend| {
+        quantile(&m.values(&scans_scene(kind), b, PlannerKind::Rrt, "time_k500"), 0.5)
+            .filter(|v| *v > 0.0)
     };
     let mut parts = Vec::new();
-    for (b, _) in &BACKENDS[..4] {
+    for &(b, _) in &BACKENDS[..4] {
         if let (Some(slow), Some(fast)) = (med("trimesh", b), med("planes", b)) {
             parts.push(format!("trimesh / planes in {b} ×{}", sig3(slow / fast)));
         }
     }
-    if let (Some(pc), Some(planes)) = (med("pc", "pointcloud"), med("planes", "rapier")) {
-        parts.push(format!("pc (pointcloud) / planes (rapier) ×{}", sig3(pc / planes)));
+    let (pc_backend, bullet) = (Backend::PointCloud, Backend::Rapier);
+    if let (Some(pc), Some(planes)) = (med("pc", pc_backend), med("planes", bullet)) {
+        parts.push(format!("pc ({pc_backend}) / planes ({bullet}) ×{}", sig3(pc / planes)));
     }
     if parts.is_empty() {
         return String::new();

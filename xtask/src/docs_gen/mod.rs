@@ -24,7 +24,8 @@ mod volume;
 use anyhow::{Context, Result, bail};
 use lab::{lab_scans_section, lab_table};
 use office::{office_sections, office_time_svg};
-use roadmap::thesis;
+use patch_map::Backend;
+use roadmap::{PlannerKind, thesis};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -32,25 +33,25 @@ use std::path::PathBuf;
 
 /// The matrix's backends in the thesis's column order, with the thesis's name for each
 /// ([`thesis::OFFICE_COLUMNS`]; the point-cloud map has no counterpart in its tables).
-const BACKENDS: [(&str, &str); 5] = [
-    ("polygon", thesis::OFFICE_COLUMNS[0]),
-    ("bbox6d", thesis::OFFICE_COLUMNS[1]),
-    ("trimesh", thesis::OFFICE_COLUMNS[2]),
-    ("rapier", thesis::OFFICE_COLUMNS[3]),
-    ("pointcloud", "–"),
+const BACKENDS: [(Backend, &str); 5] = [
+    (Backend::Polygon, thesis::OFFICE_COLUMNS[0]),
+    (Backend::BBox6d, thesis::OFFICE_COLUMNS[1]),
+    (Backend::Trimesh, thesis::OFFICE_COLUMNS[2]),
+    (Backend::Rapier, thesis::OFFICE_COLUMNS[3]),
+    (Backend::PointCloud, "–"),
 ];
 /// The matrix's planners, the thesis's five first, with their labels.
-const PLANNERS: [(&str, &str); 10] = [
-    ("rrt", "RRT"),
-    ("ma-rrt", "MA RRT"),
-    ("evasion-rrt", "Ev. RRT"),
-    ("prm", "PRM"),
-    ("ma-prm", "MA PRM"),
-    ("rrt-connect", "RRT-Connect"),
-    ("prm-star", "PRM*"),
-    ("lazy-prm", "lazy PRM"),
-    ("rrt-star", "RRT*"),
-    ("prm-valid", "PRM (valid samples)"),
+const PLANNERS: [(PlannerKind, &str); 10] = [
+    (PlannerKind::Rrt, "RRT"),
+    (PlannerKind::MaRrt, "MA RRT"),
+    (PlannerKind::EvasionRrt, "Ev. RRT"),
+    (PlannerKind::Prm, "PRM"),
+    (PlannerKind::MaPrm, "MA PRM"),
+    (PlannerKind::RrtConnect, "RRT-Connect"),
+    (PlannerKind::PrmStar, "PRM*"),
+    (PlannerKind::LazyPrm, "lazy PRM"),
+    (PlannerKind::RrtStar, "RRT*"),
+    (PlannerKind::PrmValid, "PRM (valid samples)"),
 ];
 
 /// Linear interpolation between closest ranks (type 7); `None` for no values.
@@ -71,8 +72,9 @@ pub type Runs = BTreeMap<u64, BTreeMap<String, f64>>;
 /// The matrix rows of each scene's last revision, reduced to per-case metrics.
 #[derive(Debug, Default)]
 pub struct Matrix {
-    /// (scene, backend, planner) → seed → metric → value.
-    pub cells: BTreeMap<(String, String, String), Runs>,
+    /// (scene, backend, planner) → seed → metric → value; rows naming no [`Backend`] or no
+    /// [`PlannerKind`] are left out.
+    pub cells: BTreeMap<(String, Backend, PlannerKind), Runs>,
     /// The rows used.
     pub rows: usize,
     /// The git revision of the last matrix row, and whether any row used came from a modified
@@ -125,6 +127,9 @@ impl Matrix {
             else {
                 continue;
             };
+            let (Ok(backend), Ok(planner)) = (backend.parse(), planner.parse()) else {
+                continue;
+            };
             m.scene_commands.entry(scene.clone()).or_default().extend(s("command"));
             m.cells
                 .entry((scene, backend, planner))
@@ -152,8 +157,14 @@ impl Matrix {
     }
 
     /// The values of `metric` over the successful runs of a cell (for explore runs, over all).
-    fn values(&self, scene: &str, backend: &str, planner: &str, metric: &str) -> Vec<f64> {
-        let Some(runs) = self.cells.get(&(scene.into(), backend.into(), planner.into())) else {
+    fn values(
+        &self,
+        scene: &str,
+        backend: Backend,
+        planner: PlannerKind,
+        metric: &str,
+    ) -> Vec<f64> {
+        let Some(runs) = self.cells.get(&(scene.into(), backend, planner)) else {
             return Vec::new();
         };
         runs.values()
@@ -163,8 +174,13 @@ impl Matrix {
     }
 
     /// "solved/runs" of a cell, or `None` if it has no runs.
-    fn solved(&self, scene: &str, backend: &str, planner: &str) -> Option<(usize, usize)> {
-        let runs = self.cells.get(&(scene.into(), backend.into(), planner.into()))?;
+    fn solved(
+        &self,
+        scene: &str,
+        backend: Backend,
+        planner: PlannerKind,
+    ) -> Option<(usize, usize)> {
+        let runs = self.cells.get(&(scene.into(), backend, planner))?;
         Some((runs.values().filter(|r| r.get("solved") == Some(&1.0)).count(), runs.len()))
     }
 
@@ -254,12 +270,12 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
          bench roadmap --scene lab`, then `cargo xtask docs`.\n"
     )?;
     o.push_str(&lab_table(m));
-    let med = |b: &str| quantile(&m.values("lab", b, "rrt", "time_k500"), 0.5);
+    let med = |b: Backend| quantile(&m.values("lab", b, PlannerKind::Rrt, "time_k500"), 0.5);
     let fastest = BACKENDS[..4]
         .iter()
-        .filter_map(|(b, _)| Some((med(b)?, *b)))
+        .filter_map(|&(b, _)| Some((med(b)?, b)))
         .min_by(|x, y| x.0.total_cmp(&y.0));
-    if let (Some(pc), Some((patch, name))) = (med("pointcloud"), fastest) {
+    if let (Some(pc), Some((patch, name))) = (med(Backend::PointCloud), fastest) {
         writeln!(
             o,
             "\nRRT at K = 500, point-cloud map / fastest patch map ({name}): ours ×{}; thesis: \"more than \
@@ -513,14 +529,13 @@ mod tests {
     #[test]
     fn the_lists_follow_the_thesis_and_the_planner_names() {
         // The thesis's five planners first, in its row order.
-        let first: Vec<Option<roadmap::PlannerKind>> =
-            PLANNERS[..5].iter().map(|(p, _)| p.parse().ok()).collect();
-        let rows: Vec<Option<roadmap::PlannerKind>> =
-            thesis::TABLE_5_3.rows.iter().map(|r| Some(r.planner)).collect();
+        let first: Vec<roadmap::PlannerKind> = PLANNERS[..5].iter().map(|(p, _)| *p).collect();
+        let rows: Vec<roadmap::PlannerKind> =
+            thesis::TABLE_5_3.rows.iter().map(|r| r.planner).collect();
         assert_eq!(first, rows);
         // Every planner of the crate has a row.
         for kind in roadmap::PlannerKind::ALL {
-            assert!(PLANNERS.iter().any(|(p, _)| *p == kind.name()), "{kind} has no row");
+            assert!(PLANNERS.iter().any(|(p, _)| *p == kind), "{kind} has no row");
         }
         let columns: Vec<&str> = BACKENDS[..4].iter().map(|b| b.1).collect();
         assert_eq!(columns, thesis::OFFICE_COLUMNS);

@@ -9,6 +9,7 @@
 //! the thesis's figures show (3/20 = .150); 0 where a run has no turns.
 
 use super::{BACKENDS, Matrix, PLANNERS, quantile, sig3, time_text};
+use patch_map::Backend;
 use roadmap::PlannerKind;
 use roadmap::thesis::{self, OfficeTable, QuartileRatios, Turns};
 use std::fmt::Write as _;
@@ -115,11 +116,6 @@ const SECTIONS: [Section; 9] = [
     },
 ];
 
-/// The thesis's planner of a matrix planner name, if it is one of ours.
-fn kind(planner: &str) -> Option<PlannerKind> {
-    planner.parse().ok()
-}
-
 /// "×ours/thesis", or "×–" where the thesis's figure is 0.
 fn times(ours: f64, thesis: f64) -> String {
     if thesis == 0.0 { "×–".into() } else { format!("×{}", sig3(ours / thesis)) }
@@ -156,18 +152,18 @@ fn steep_ratio(steep: f64, turns: f64) -> f64 {
 
 /// The text of one cell of `measure` for planner `p` on backend `b` (column `col` of
 /// [`BACKENDS`]).
-fn cell_text(measure: Measure, m: &Matrix, b: &str, col: usize, p: &str) -> String {
+fn cell_text(measure: Measure, m: &Matrix, b: Backend, col: usize, p: PlannerKind) -> String {
     match measure {
         Measure::Median { metric, thesis, fmt } => {
             let ours = quantile(&m.values("office", b, p, metric), 0.5);
-            cell(ours, kind(p).and_then(|k| thesis.cell(k, col)), fmt)
+            cell(ours, thesis.cell(p, col), fmt)
         }
         Measure::Quartiles { metric, thesis } => {
             let Some(o) = quartile_ratios(&m.values("office", b, p, metric)) else {
                 return "–".into();
             };
             let ours = format!("{:.3}/{:.3}", o.lower, o.upper);
-            match kind(p).and_then(|k| thesis.cell(k, col)) {
+            match thesis.cell(p, col) {
                 None => ours,
                 Some(t) => format!(
                     "{ours} / {:.3}/{:.3} ({}/{})",
@@ -184,7 +180,7 @@ fn cell_text(measure: Measure, m: &Matrix, b: &str, col: usize, p: &str) -> Stri
             let (Some(steep), Some(turns)) = (steep, turns) else { return "–".into() };
             let ratio = steep_ratio(steep, turns);
             let ours = format!("{}/{}/{ratio:.3}", count(steep), count(turns));
-            match kind(p).and_then(|k| thesis.cell(k, col)) {
+            match thesis.cell(p, col) {
                 None => ours,
                 Some(t) => format!(
                     "{ours} / {}/{}/{:.3} ({}/{}/{})",
@@ -216,12 +212,12 @@ fn office_table(m: &Matrix, measure: Measure) -> String {
     out.push_str(&rule);
     out.push_str("---|\n");
     for (p, label) in PLANNERS {
-        if !BACKENDS.iter().any(|(b, _)| m.solved("office", b, p).is_some()) {
+        if !BACKENDS.iter().any(|&(b, _)| m.solved("office", b, p).is_some()) {
             continue;
         }
         let _ = write!(out, "| {label} |");
         let mut solved = Vec::new();
-        for (i, (b, _)) in BACKENDS.iter().enumerate() {
+        for (i, &(b, _)) in BACKENDS.iter().enumerate() {
             let text = if m.solved("office", b, p).is_some() {
                 cell_text(measure, m, b, i, p)
             } else {
@@ -312,16 +308,15 @@ pub(super) fn office_sections(m: &Matrix, svg_name: &str) -> String {
 /// The plot: median office time per planner (groups) and backend (bars) on a log axis, the
 /// thesis's Table 5.3 as black ticks on the bars of its four columns.
 pub fn office_time_svg(m: &Matrix) -> String {
-    let planners: Vec<(&str, &str)> = PLANNERS
+    let planners: Vec<(PlannerKind, &str)> = PLANNERS
         .iter()
         .copied()
-        .filter(|(p, _)| BACKENDS.iter().any(|(b, _)| m.solved("office", b, p).is_some()))
+        .filter(|&(p, _)| BACKENDS.iter().any(|&(b, _)| m.solved("office", b, p).is_some()))
         .collect();
     let colours = ["#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#9c755f"];
-    let thesis_time =
-        |p: &str, column: usize| kind(p).and_then(|k| thesis::TABLE_5_3.cell(k, column));
+    let thesis_time = |p: PlannerKind, column: usize| thesis::TABLE_5_3.cell(p, column);
     let mut values = Vec::new();
-    for (p, _) in &planners {
+    for &(p, _) in &planners {
         for (b, _) in BACKENDS {
             values.extend(quantile(&m.values("office", b, p, "time"), 0.5));
         }
@@ -364,9 +359,9 @@ pub fn office_time_svg(m: &Matrix) -> String {
         );
         d += 1.0;
     }
-    for (g, (p, label)) in planners.iter().enumerate() {
+    for (g, &(p, label)) in planners.iter().enumerate() {
         let x0 = left + g as f64 * group + group * 0.1;
-        for (i, (b, _)) in BACKENDS.iter().enumerate() {
+        for (i, &(b, _)) in BACKENDS.iter().enumerate() {
             let x = x0 + i as f64 * bar;
             if let Some(v) = quantile(&m.values("office", b, p, "time"), 0.5).filter(|v| *v > 0.0) {
                 let yy = y(v);

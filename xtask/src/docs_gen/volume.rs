@@ -10,6 +10,7 @@
 //! every cell.
 
 use super::sig3;
+use roadmap::PlannerKind;
 use roadmap::thesis::{self, LAB_MAPS, TABLE_6_1, VolumeRow};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
@@ -67,7 +68,7 @@ impl VolumeRun {
     }
 
     /// A key of the first volume row of `planner` (its parameters).
-    fn param(&self, planner: &str, key: &str) -> Option<&Value> {
+    fn param(&self, planner: PlannerKind, key: &str) -> Option<&Value> {
         LAB_MAPS.iter().find_map(|m| self.rows.get(&format!("lab-volume/{planner}/{m}"))?.get(key))
     }
 }
@@ -127,8 +128,8 @@ pub(super) fn volume_section(rows: &[Value]) -> String {
         }
     );
     o.push_str(&contents_table(&run));
-    o.push_str(&volume_table(&run, "rrt", "6.2", "RRT", &thesis::TABLE_6_2_RRT));
-    o.push_str(&volume_table(&run, "prm", "6.4", "PRM", &thesis::TABLE_6_4_PRM));
+    o.push_str(&volume_table(&run, PlannerKind::Rrt, "6.2", "RRT", &thesis::TABLE_6_2_RRT));
+    o.push_str(&volume_table(&run, PlannerKind::Prm, "6.4", "PRM", &thesis::TABLE_6_4_PRM));
     o
 }
 
@@ -222,7 +223,7 @@ fn contents_table(run: &VolumeRun) -> String {
 /// parameters; a sentence when the rows hold none of `planner`.
 fn volume_table(
     run: &VolumeRun,
-    planner: &str,
+    planner: PlannerKind,
     number: &str,
     label: &str,
     thesis_rows: &[VolumeRow; 4],
@@ -238,7 +239,7 @@ fn volume_table(
     let p = |key: &str| run.param(planner, key).and_then(Value::as_f64);
     let n = |key: &str| p(key).map_or("?".to_owned(), |v| format!("{v}"));
     let cell_mm = p("cell_size_m").map_or("?".to_owned(), |c| sig3(c * 1e3));
-    let runs = if planner == "rrt" {
+    let runs = if planner == PlannerKind::Rrt {
         format!(
             "{} start(s) × {} seeds = {} roadmaps per map, K = {}, robot radius {} m, step {} m",
             n("starts"),
@@ -263,7 +264,7 @@ fn volume_table(
         "Ours / thesis. Ours: {runs}, {}³ cells of {cell_mm} mm; the thesis: {}, 1024³ cells of \
          38.684 mm.\n",
         n("cells"),
-        if planner == "rrt" {
+        if planner == PlannerKind::Rrt {
             "480 roadmaps per map (4 corners × 120 seeds), K = 10,000"
         } else {
             "seeds and K not given (spec §7.11)"

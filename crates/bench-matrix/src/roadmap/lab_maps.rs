@@ -13,8 +13,8 @@
 
 use super::lab_scene;
 use anyhow::{Context, Result, bail};
-use patch_core::{FromPatches, Point3, Real};
-use patch_map::{AnyMap, BBox6dMap, PolygonMap, RapierMap, TrimeshMap, load_any};
+use patch_core::{Point3, Real};
+use patch_map::{AnyMap, Backend, load_any};
 use pointcloud::Aabb;
 use std::fs::File;
 use std::io::BufReader;
@@ -27,8 +27,6 @@ pub(crate) const SCENE_PREFIX: &str = "lab-scans-";
 /// The thesis's map types (Table 6.1), in its order of discussion; the file of kind `k` is
 /// `k.pmap`.
 pub(crate) const KINDS: [&str; 4] = ["planes", "hybrid", "trimesh", "pc"];
-/// The backends a patch map is loaded into.
-const PATCH_BACKENDS: [&str; 4] = ["polygon", "bbox6d", "trimesh", "rapier"];
 
 /// The map kind of a scene `lab-scans-<kind>`, if it is one.
 pub(crate) fn kind_of(scene: &str) -> Option<&'static str> {
@@ -36,10 +34,10 @@ pub(crate) fn kind_of(scene: &str) -> Option<&'static str> {
     KINDS.iter().copied().find(|k| *k == kind)
 }
 
-/// The backends that can hold a map of `kind`: the four patch backends, or the point-cloud
-/// map for `pc`.
-pub(crate) fn backends_for(kind: &str) -> &'static [&'static str] {
-    if kind == "pc" { &["pointcloud"] } else { &PATCH_BACKENDS }
+/// Whether `backend` can hold a map of `kind`: the patch backends hold the patch maps, the
+/// point-cloud map holds `pc`.
+pub(crate) fn holds(backend: Backend, kind: &str) -> bool {
+    backend.holds_patches() != (kind == "pc")
 }
 
 /// The folder of map files named by [`LAB_MAPS_ENV`], if set.
@@ -133,25 +131,21 @@ impl LabMaps {
     pub(crate) fn take_maps(
         &mut self,
         kind: &str,
-        backends: &[&'static str],
-    ) -> Result<Vec<(&'static str, AnyMap)>> {
+        backends: &[Backend],
+    ) -> Result<Vec<(Backend, AnyMap)>> {
         let slot = self.maps.iter_mut().find(|(k, _)| *k == kind).context("no such map kind")?;
         let mut own =
             Some(slot.1.take().with_context(|| format!("the {kind} map was already used"))?);
         let patches = own.as_ref().and_then(AnyMap::patches).map(<[_]>::to_vec);
         let mut out = Vec::new();
-        for &backend in backends.iter().filter(|b| backends_for(kind).contains(b)) {
+        for &backend in backends.iter().filter(|&&b| holds(b, kind)) {
             let map = match own.take_if(|m| m.backend() == backend) {
                 Some(map) => map,
                 None => {
                     let patches = patches.clone().context("a point-cloud map has no patches")?;
-                    match backend {
-                        "polygon" => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
-                        "bbox6d" => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
-                        "trimesh" => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
-                        "rapier" => AnyMap::Rapier(RapierMap::from_patches(patches)?),
-                        other => bail!("a {kind} map cannot be held by the `{other}` backend"),
-                    }
+                    AnyMap::from_patches(backend, patches, None).with_context(|| {
+                        format!("a {kind} map cannot be held by the `{backend}` backend")
+                    })?
                 }
             };
             out.push((backend, map));
@@ -163,8 +157,10 @@ impl LabMaps {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use patch_core::{PlanarPatch, TrimeshPatch};
-    use patch_map::{MapFile, PointCloudMap, sample_patch_points};
+    use patch_core::{FromPatches, PlanarPatch, TrimeshPatch};
+    use patch_map::{
+        BBox6dMap, MapFile, PointCloudMap, PolygonMap, TrimeshMap, sample_patch_points,
+    };
 
     /// A fresh folder under the system's temporary folder, removed on drop.
     pub(crate) struct TempDir(pub PathBuf);
@@ -241,10 +237,14 @@ pub(crate) mod tests {
         // The start lies inside every map's box and is free on all four.
         assert_eq!(maps.start, p(0.6, 0.6, 1.0));
         assert!(maps.bounds("pc").unwrap().max.z > 1.9);
-        let all = ["polygon", "bbox6d", "trimesh", "rapier", "pointcloud"];
+        let all = Backend::ALL;
         let hybrid = maps.take_maps("hybrid", &all).unwrap();
-        let names: Vec<&str> = hybrid.iter().map(|m| m.0).collect();
-        assert_eq!(names, PATCH_BACKENDS, "patch maps in the four patch backends");
+        let names: Vec<Backend> = hybrid.iter().map(|m| m.0).collect();
+        assert_eq!(
+            names,
+            Backend::patch_backends().collect::<Vec<_>>(),
+            "patch maps in the four patch backends"
+        );
         for (backend, map) in &hybrid {
             assert_eq!(map.backend(), *backend);
             assert_eq!(map.patches().unwrap().len(), 3, "{backend}");
@@ -252,8 +252,8 @@ pub(crate) mod tests {
         assert!(maps.take_maps("hybrid", &all).is_err(), "taken once");
         let pc = maps.take_maps("pc", &all).unwrap();
         assert_eq!(pc.len(), 1);
-        assert_eq!(pc[0].1.backend(), "pointcloud");
-        assert!(maps.take_maps("planes", &["pointcloud"]).unwrap().is_empty());
+        assert_eq!(pc[0].1.backend(), Backend::PointCloud);
+        assert!(maps.take_maps("planes", &[Backend::PointCloud]).unwrap().is_empty());
         assert_eq!(kind_of("lab-scans-pc"), Some("pc"));
         assert_eq!(kind_of("lab-scans-moon"), None);
         assert_eq!(kind_of("lab"), None);

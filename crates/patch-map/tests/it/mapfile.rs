@@ -9,7 +9,9 @@ use patch_core::{
     ProximityQuery, Real, SpecificStepIntersector, TrimeshPatch, UnspecificStepIntersector,
 };
 use patch_map::mapfile::{FORMAT_VERSION, MapCounts, MapFileError, read_header, write_map};
-use patch_map::{AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap, load_any};
+use patch_map::{
+    AnyMap, BBox6dMap, Backend, MapFile, MemoryUsage, PointCloudMap, PolygonMap, load_any,
+};
 use proptest::prelude::*;
 
 fn save<M: MapFile>(map: &M) -> Vec<u8> {
@@ -151,7 +153,7 @@ proptest! {
             prop_assert_eq!(back.is_step_free(&s.line()), map.is_step_free(&s.line()));
         }
         let any = load_any(&bytes[..]).unwrap();
-        prop_assert_eq!(any.backend(), "pointcloud");
+        prop_assert_eq!(any.backend(), Backend::PointCloud);
         prop_assert!(any.patches().is_none());
         for s in &steps {
             prop_assert_eq!(any.is_step_free(s), map.is_step_free(s));
@@ -163,7 +165,7 @@ proptest! {
 fn load_any_dispatches_on_the_tag() {
     for (tag, bytes) in files() {
         let any = load_any(&bytes[..]).unwrap();
-        assert_eq!(any.backend(), tag);
+        assert_eq!(any.backend().name(), tag);
         assert_eq!(any.counts(), read_header(&bytes[..]).unwrap().counts);
         assert!(any.memory_bytes() > 0);
         // Saving the loaded map gives the same file (the payload does not depend on indices).

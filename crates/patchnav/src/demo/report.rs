@@ -14,6 +14,7 @@ use super::model::{
 };
 use anyhow::Result;
 use html::{DASH, bytes, esc, fixed, int, not_computed, para, seconds, sig, table, yes_no};
+use roadmap::PlannerKind;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -551,7 +552,7 @@ fn section_volume(vol: Option<&VolumeSection>) -> String {
         let header_refs: Vec<&str> = headers.iter().map(String::as_str).collect();
         out.push_str(&table(&header_refs, &rows));
     }
-    let (thesis, title) = if v.planner == "prm" {
+    let (thesis, title) = if matches!(v.planner.parse(), Ok(PlannerKind::Prm)) {
         (&roadmap::thesis::TABLE_6_4_PRM, "Thesis Table 6.4 (PRM, Lab)")
     } else {
         (&roadmap::thesis::TABLE_6_2_RRT, "Thesis Table 6.2 (RRT, Lab)")

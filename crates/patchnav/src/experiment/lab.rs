@@ -47,15 +47,14 @@
 
 use crate::progress::Progress;
 use crate::scene_map::{
-    BuiltMap, MapKind, MapSource, PatchBackend, PcCleaning, ScanSetup, SceneSurfaces, Tessellation,
-    build_map,
+    BuiltMap, MapKind, MapSource, PcCleaning, ScanSetup, SceneSurfaces, Tessellation, build_map,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
 use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix};
-use patch_map::AnyMap;
+use patch_map::{AnyMap, Backend};
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
 use roadmap::thesis;
@@ -97,8 +96,8 @@ pub struct LabMapArgs {
     #[arg(long, value_enum, default_value_t = MapSource::Scans)]
     pub source: MapSource,
     /// Backend of the planes, hybrid and trimesh maps (the pc map is always a point-cloud map).
-    #[arg(long, value_enum, default_value_t = PatchBackend::Trimesh)]
-    pub backend: PatchBackend,
+    #[arg(long, value_parser = crate::names::patch_backends(), default_value_t = Backend::Trimesh)]
+    pub backend: Backend,
     /// The map types to run, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = MapKind::ALL)]
     pub maps: Vec<MapKind>,

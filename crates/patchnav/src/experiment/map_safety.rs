@@ -17,15 +17,17 @@
 use super::extraction::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
-    MapKind, PatchBackend, PcCleaning, ScanSetup, extracted_patches, patch_map, pc_points,
-    scan_clouds, scan_clouds_without_phantoms, truth_patches,
+    MapKind, PcCleaning, ScanSetup, extracted_patches, patch_map, pc_points, scan_clouds,
+    scan_clouds_without_phantoms, truth_patches,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
 use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix};
-use patch_map::{AnyMap, Attribution, MapComparison, PointCloudMap, StepSampling, compare_maps};
+use patch_map::{
+    AnyMap, Attribution, Backend, MapComparison, PointCloudMap, StepSampling, compare_maps,
+};
 use roadmap::{Goal, MaxIterations, PlannerKind, PlanningSpace, Problem, named_planner_on};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -166,7 +168,7 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
         }
         let scene = scene_sim::scene_by_name(name, args.scene_seed)
             .with_context(|| format!("building scene `{name}`"))?;
-        let truth = patch_map(truth_patches(&scene)?, PatchBackend::Bbox6d)?;
+        let truth = patch_map(truth_patches(&scene)?, Backend::BBox6d)?;
         let sampling = StepSampling {
             radius: args.radius,
             max_length: args.max_length,
@@ -194,7 +196,7 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     let extract_seconds = started.elapsed().as_secs_f64();
                     let started = Instant::now();
                     let map = match patches {
-                        Some(patches) => patch_map(patches, PatchBackend::Trimesh)?,
+                        Some(patches) => patch_map(patches, Backend::Trimesh)?,
                         None => AnyMap::PointCloud(PointCloudMap::from_points(&points)?),
                     };
                     let times =

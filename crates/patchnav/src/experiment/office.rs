@@ -40,17 +40,18 @@
 //! planner gets the same iteration cap (`--max-iterations`, 100,000 by default) and a run that
 //! has not reached all four ROIs by then counts as a failure, reported as `n/N`.
 
-use crate::plan::{PlannerChoice, make_planner};
+use crate::names;
+use crate::plan::make_planner;
 use crate::problem::{
-    Mode, ProblemBackend, map_from_patches, read_patches, read_problem, run_row, skipped_row,
-    solve_timed,
+    Mode, map_from_patches, read_patches, read_problem, run_row, skipped_row, solve_timed,
 };
 use crate::progress::Progress;
-use PlannerChoice as P;
-use ProblemBackend as B;
+use Backend as B;
+use PlannerKind as P;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{Point3, Real};
+use patch_map::Backend;
 use roadmap::metrics::{added_length, quantile, turn_angles, upper_quartile};
 use roadmap::thesis::{self, OFFICE_COLUMNS, OfficeTable, QuartileRatios, Turns};
 use roadmap::{PathMetrics, Planner, PlannerKind};
@@ -75,11 +76,11 @@ pub struct OfficeArgs {
     #[arg(long = "max-iterations", default_value_t = 100_000)]
     pub max_iterations: u64,
     /// Only these planners (comma-separated; default: all, in the thesis's order).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub planners: Vec<PlannerChoice>,
+    #[arg(long, value_parser = names::all::<PlannerKind>(), value_delimiter = ',')]
+    pub planners: Vec<PlannerKind>,
     /// Only these backends (comma-separated; default: all, in the thesis's column order).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub backends: Vec<ProblemBackend>,
+    #[arg(long, value_parser = names::all::<Backend>(), value_delimiter = ',')]
+    pub backends: Vec<Backend>,
     /// Also write one JSON line per run (the rows of `plan --problem` plus the metrics).
     #[arg(long)]
     pub jsonl: Option<PathBuf>,
@@ -91,32 +92,32 @@ pub struct OfficeArgs {
 
 /// A row of the tables: a planner and its label.
 struct PlannerRow {
-    choice: PlannerChoice,
+    kind: PlannerKind,
     label: &'static str,
 }
 
 /// The rows of the tables: the thesis's five in its order (Table 5.3), then ours. Adding a
 /// planner is one line here (a planner that cannot plan to four goals is reported as skipped).
 const PLANNERS: &[PlannerRow] = &[
-    PlannerRow { choice: PlannerChoice::Rrt, label: "RRT" },
-    PlannerRow { choice: PlannerChoice::MaRrt, label: "MA RRT" },
-    PlannerRow { choice: PlannerChoice::EvasionRrt, label: "Ev. RRT" },
-    PlannerRow { choice: PlannerChoice::Prm, label: "PRM" },
-    PlannerRow { choice: PlannerChoice::MaPrm, label: "MA PRM" },
-    PlannerRow { choice: PlannerChoice::RrtConnect, label: "RRT-Connect" },
-    PlannerRow { choice: PlannerChoice::PrmStar, label: "PRM*" },
-    PlannerRow { choice: PlannerChoice::LazyPrm, label: "lazy PRM" },
-    PlannerRow { choice: PlannerChoice::RrtStar, label: "RRT*" },
+    PlannerRow { kind: PlannerKind::Rrt, label: "RRT" },
+    PlannerRow { kind: PlannerKind::MaRrt, label: "MA RRT" },
+    PlannerRow { kind: PlannerKind::EvasionRrt, label: "Ev. RRT" },
+    PlannerRow { kind: PlannerKind::Prm, label: "PRM" },
+    PlannerRow { kind: PlannerKind::MaPrm, label: "MA PRM" },
+    PlannerRow { kind: PlannerKind::RrtConnect, label: "RRT-Connect" },
+    PlannerRow { kind: PlannerKind::PrmStar, label: "PRM*" },
+    PlannerRow { kind: PlannerKind::LazyPrm, label: "lazy PRM" },
+    PlannerRow { kind: PlannerKind::RrtStar, label: "RRT*" },
 ];
 
-/// The columns: ours in the thesis's order Simple | BB6D | OPCODE | Bullet, then the
-/// point-cloud map (Algorithm 10), which the thesis's table does not have.
-const BACKENDS: &[(ProblemBackend, &str, &str)] = &[
-    (ProblemBackend::Polygon, "polygon", "Simple"),
-    (ProblemBackend::Bbox6d, "bbox6d", "BB6D"),
-    (ProblemBackend::Trimesh, "trimesh", "OPCODE"),
-    (ProblemBackend::Rapier, "rapier", "Bullet"),
-    (ProblemBackend::Pointcloud, "pointcloud", "–"),
+/// The columns with the thesis's names: ours in the thesis's order Simple | BB6D | OPCODE |
+/// Bullet, then the point-cloud map (Algorithm 10), which the thesis's table does not have.
+const BACKENDS: &[(Backend, &str)] = &[
+    (Backend::Polygon, "Simple"),
+    (Backend::BBox6d, "BB6D"),
+    (Backend::Trimesh, "OPCODE"),
+    (Backend::Rapier, "Bullet"),
+    (Backend::PointCloud, "–"),
 ];
 
 /// The metrics of one successful run (see the [module docs](self)).
@@ -163,7 +164,7 @@ impl Cell {
 /// The results: `cells[planner][backend]` over the selected planners and backends.
 struct Results<'a> {
     planners: Vec<&'a PlannerRow>,
-    backends: Vec<&'a (ProblemBackend, &'static str, &'static str)>,
+    backends: Vec<&'a (Backend, &'static str)>,
     cells: Vec<Vec<Cell>>,
 }
 
@@ -338,7 +339,7 @@ fn thesis_table(spec: &TableSpec) -> String {
     for (row, &choice) in FIVE.iter().enumerate() {
         for (suffix, _, cell) in spec.rows {
             let mut line = vec![format!("{}{suffix}", thesis_label(row))];
-            line.extend((0..4).map(|c| cell(choice.kind(), c).unwrap_or_else(|| "–".to_owned())));
+            line.extend((0..4).map(|c| cell(choice, c).unwrap_or_else(|| "–".to_owned())));
             rows.push(line);
         }
     }
@@ -371,8 +372,8 @@ fn layout(rows: &[Vec<String>]) -> String {
 }
 
 impl Results<'_> {
-    fn cell(&self, planner: PlannerChoice, backend: ProblemBackend) -> Option<&Cell> {
-        let i = self.planners.iter().position(|p| p.choice == planner)?;
+    fn cell(&self, planner: PlannerKind, backend: Backend) -> Option<&Cell> {
+        let i = self.planners.iter().position(|p| p.kind == planner)?;
         let j = self.backends.iter().position(|b| b.0 == backend)?;
         Some(&self.cells[i][j])
     }
@@ -380,8 +381,8 @@ impl Results<'_> {
     /// The median of `f` over the successful runs of a cell.
     fn median(
         &self,
-        planner: PlannerChoice,
-        backend: ProblemBackend,
+        planner: PlannerKind,
+        backend: Backend,
         f: fn(&RunMetrics) -> Real,
     ) -> Option<Real> {
         quantile(&metric(&self.cell(planner, backend)?.successes(), f), 0.5)
@@ -389,8 +390,8 @@ impl Results<'_> {
 
     fn quartiles(
         &self,
-        planner: PlannerChoice,
-        backend: ProblemBackend,
+        planner: PlannerKind,
+        backend: Backend,
         f: fn(&RunMetrics) -> Real,
     ) -> Option<[Real; 3]> {
         quartiles(&metric(&self.cell(planner, backend)?.successes(), f))
@@ -444,7 +445,7 @@ impl Results<'_> {
         header.extend(
             self.backends
                 .iter()
-                .map(|b| if b.2 == "–" { b.1.to_owned() } else { format!("{} ({})", b.1, b.2) }),
+                .map(|b| if b.1 == "–" { b.0.to_string() } else { format!("{} ({})", b.0, b.1) }),
         );
         let mut rows = vec![header];
         for i in self.shown_planners() {
@@ -479,14 +480,14 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
     let space = p.space().with_context(|| args.problem.display().to_string())?;
     let query = p.query(&p.goals);
     let patches = read_patches(&p)?;
-    for choice in &args.planners {
-        if !PLANNERS.iter().any(|r| r.choice == *choice) {
-            bail!("planner {} is not in the office experiment's list", choice.cli_name());
+    for kind in &args.planners {
+        if !PLANNERS.iter().any(|r| r.kind == *kind) {
+            bail!("planner {kind} is not in the office experiment's list");
         }
     }
     let planners: Vec<&PlannerRow> = PLANNERS
         .iter()
-        .filter(|r| args.planners.is_empty() || args.planners.contains(&r.choice))
+        .filter(|r| args.planners.is_empty() || args.planners.contains(&r.kind))
         .collect();
     let backends: Vec<_> = BACKENDS
         .iter()
@@ -497,21 +498,21 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
     let run_cells = |mut jsonl: Option<&mut dyn std::io::Write>| -> Result<Vec<Vec<Cell>>> {
         let mut cells: Vec<Vec<Cell>> = planners.iter().map(|_| Vec::new()).collect();
         let bar = progress.bar((planners.len() * backends.len()) as u64 * args.seeds, "runs");
-        for &&(backend, name, _) in &backends {
+        for &&(backend, _) in &backends {
             let map = map_from_patches(&p, patches.clone(), backend, args.sample_spacing)
-                .with_context(|| format!("building the `{name}` map"))?;
+                .with_context(|| format!("building the `{backend}` map"))?;
             for (i, row) in planners.iter().enumerate() {
                 let mut runs = Vec::new();
                 let mut cannot = None;
                 for seed in 0..args.seeds {
                     bar.inc(1);
-                    let mut planner = match make_planner(row.choice, &map, space, seed) {
+                    let mut planner = match make_planner(row.kind, &map, space, seed) {
                         Ok(planner) => planner,
                         Err(reason) => {
                             if let Some(out) = &mut jsonl {
                                 let line = skipped_row(
                                     &p,
-                                    row.choice,
+                                    row.kind,
                                     map.backend(),
                                     Mode::Roi,
                                     seed,
@@ -610,27 +611,23 @@ pub fn run(args: &OfficeArgs, progress: &Progress) -> Result<()> {
 // The thesis's prose claims (spec §5.1 "Claims in the prose", §7.15), checked on the data.
 
 /// The thesis's five planners, its row order.
-const FIVE: [PlannerChoice; 5] = [P::Rrt, P::MaRrt, P::EvasionRrt, P::Prm, P::MaPrm];
+const FIVE: [PlannerKind; 5] = [P::Rrt, P::MaRrt, P::EvasionRrt, P::Prm, P::MaPrm];
 /// Our counterparts of the thesis's columns.
-const FOUR: [ProblemBackend; 4] = [B::Polygon, B::Bbox6d, B::Trimesh, B::Rapier];
+const FOUR: [Backend; 4] = [B::Polygon, B::BBox6d, B::Trimesh, B::Rapier];
 
-fn label(choice: PlannerChoice) -> &'static str {
-    PLANNERS.iter().find(|r| r.choice == choice).map_or("?", |r| r.label)
-}
-
-fn backend_name(backend: ProblemBackend) -> &'static str {
-    BACKENDS.iter().find(|b| b.0 == backend).map_or("?", |b| b.1)
+fn label(kind: PlannerKind) -> &'static str {
+    PLANNERS.iter().find(|r| r.kind == kind).map_or("?", |r| r.label)
 }
 
 /// The thesis's figure of `table` at planner `row` (index into [`FIVE`]) and column `col`
 /// (index into [`FOUR`] and [`OFFICE_COLUMNS`]); `None` for "–".
 fn thesis_value<T: Copy>(table: &OfficeTable<T>, row: usize, col: usize) -> Option<T> {
-    table.cell(FIVE[row].kind(), col)
+    table.cell(FIVE[row], col)
 }
 
 /// The thesis's label of planner `row` (index into [`FIVE`]).
 fn thesis_label(row: usize) -> &'static str {
-    let kind = FIVE[row].kind();
+    let kind = FIVE[row];
     thesis::TABLE_5_3.rows.iter().find(|r| r.planner == kind).map_or("?", |r| r.label)
 }
 
@@ -656,7 +653,7 @@ fn yes(b: bool) -> &'static str {
 /// Per column, `check` on the column's values (ours: our backends; thesis: its columns).
 fn per_column(
     results: &Results<'_>,
-    ours: impl Fn(PlannerChoice, ProblemBackend) -> Option<Real>,
+    ours: impl Fn(PlannerKind, Backend) -> Option<Real>,
     thesis: impl Fn(usize, usize) -> Option<Real>,
     check: impl Fn(&Column) -> Option<String>,
 ) -> (String, String) {
@@ -671,7 +668,7 @@ fn per_column(
         .iter()
         .filter_map(|b| {
             let col: Column = std::array::from_fn(|r| ours(FIVE[r], b.0));
-            check(&col).map(|s| format!("{} {s}", b.1))
+            check(&col).map(|s| format!("{} {s}", b.0))
         })
         .collect();
     (thesis_parts.join(", "), our_parts.join(", "))
@@ -764,7 +761,10 @@ fn claims(r: &Results<'_>) -> String {
             &mut out,
             "Naive maps vs Bullet: factor 2.35 worst (Simple/MA PRM), 1.09 best (BB6D/MA RRT) \
              (L6200–6204; §7.15: the table gives 2.90)",
-            (factors(&t_time, ["Simple", "BB6D"]), factors(&ours, ["polygon", "bbox6d"])),
+            (
+                factors(&t_time, ["Simple", "BB6D"]),
+                factors(&ours, [FOUR[0].name(), FOUR[1].name()]),
+            ),
         );
     }
     {
@@ -863,10 +863,7 @@ fn claims(r: &Results<'_>) -> String {
             &mut out,
             "Among the frameworks OPCODE is the most stable, Bullet and Simple vary most \
              (L6207–6208): mean (upper − lower)/median of RRT and PRM time",
-            (
-                mean_spread(&t_spread, &OFFICE_COLUMNS),
-                mean_spread(&ours, &["polygon", "bbox6d", "trimesh", "rapier"]),
-            ),
+            (mean_spread(&t_spread, &OFFICE_COLUMNS), mean_spread(&ours, &FOUR.map(Backend::name))),
         );
     }
     let t_len = |row, col| thesis_value(&thesis::TABLE_5_5, row, col);
@@ -904,7 +901,7 @@ fn claims(r: &Results<'_>) -> String {
             },
         ),
     );
-    let our_ratio = |p: PlannerChoice, b: ProblemBackend| {
+    let our_ratio = |p: PlannerKind, b: Backend| {
         let s = r.median(p, b, |m| m.steep)?;
         Some(steep_ratio(s, r.median(p, b, |m| m.turns)?))
     };
@@ -983,7 +980,7 @@ fn claims(r: &Results<'_>) -> String {
             }
             for b in &r.backends {
                 if let Some(q) = r.quartiles(planner, b.0, curv) {
-                    ours.push((q[0] / q[1], q[2] / q[1], format!("{name}/{}", b.1)));
+                    ours.push((q[0] / q[1], q[2] / q[1], format!("{name}/{}", b.0)));
                 }
             }
         }
@@ -1013,7 +1010,7 @@ fn claims(r: &Results<'_>) -> String {
                     let col: Column = std::array::from_fn(|c| {
                         (c < 4).then(|| r.median(p, FOUR[c], time)).flatten()
                     });
-                    let best = argmin(&col).map_or("–", |c| backend_name(FOUR[c]));
+                    let best = argmin(&col).map_or_else(|| "–".to_owned(), |c| FOUR[c].to_string());
                     format!("{} {best}", label(p))
                 })
                 .collect();
@@ -1071,7 +1068,7 @@ fn claims(r: &Results<'_>) -> String {
             .iter()
             .filter_map(|b| match r.cell(P::MaPrm, b.0)? {
                 Cell::Ran(runs) => {
-                    Some(format!("{} {}/{}", b.1, runs.iter().flatten().count(), runs.len()))
+                    Some(format!("{} {}/{}", b.0, runs.iter().flatten().count(), runs.len()))
                 }
                 Cell::Cannot(_) => None,
             })
@@ -1136,10 +1133,10 @@ mod tests {
     #[test]
     fn the_thesis_rows_come_first_in_its_order() {
         // Every planner of the thesis has a row, in the thesis's order, before ours.
-        let first: Vec<PlannerKind> = PLANNERS.iter().take(5).map(|r| r.choice.kind()).collect();
+        let first: Vec<PlannerKind> = PLANNERS.iter().take(5).map(|r| r.kind).collect();
         let thesis: Vec<PlannerKind> = thesis::TABLE_5_3.rows.iter().map(|r| r.planner).collect();
         assert_eq!(first, thesis);
-        assert_eq!(FIVE.map(PlannerChoice::kind).to_vec(), thesis);
+        assert_eq!(FIVE.to_vec(), thesis);
         let labels: Vec<&str> = PLANNERS.iter().take(5).map(|r| r.label).collect();
         assert_eq!(labels, (0..5).map(thesis_label).collect::<Vec<_>>());
         // The claims read the thesis through the planner: MA RRT has no OPCODE figure.

@@ -4,14 +4,16 @@
 
 use crate::demo::model::Scale;
 use crate::demo::pipeline::Settings;
-use crate::demo::pipeline::explore::{ExplorePlanner, MAX_VOLUME_MAPS};
+use crate::demo::pipeline::explore::{EXPLORE_PLANNERS, MAX_VOLUME_MAPS};
 use crate::extract::SensorPreset;
-use crate::plan::PlannerChoice;
-use crate::scene_map::{MapKind, PatchBackend, Tessellation};
+use crate::names::{self, NameParser, Named};
+use crate::scene_map::{MapKind, Tessellation};
 use crate::terrain::AxesChoice;
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use patch_core::{Point3, Real};
+use patch_map::Backend;
+use roadmap::PlannerKind;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -177,7 +179,7 @@ pub struct PlanConfig {
     /// How close a vertex must come to a goal, metres.
     pub goal_tolerance: Real,
     /// Planners, in order.
-    pub planners: Vec<PlannerChoice>,
+    pub planners: Vec<PlannerKind>,
     /// Seeds of every planner.
     pub seeds: Vec<u64>,
     /// Iteration budget of each run (it stops earlier once every goal is reached).
@@ -238,8 +240,8 @@ pub struct TimingConfig {
 /// Explored volume compared across the maps (`[volume]`, thesis Table 6.2 / 6.4, Fig 6.1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VolumeConfig {
-    /// The planner grown.
-    pub planner: ExplorePlanner,
+    /// The planner grown, one of [`EXPLORE_PLANNERS`].
+    pub planner: PlannerKind,
     /// Iterations of every run.
     pub iterations: u64,
     /// Seeds, each run from every start.
@@ -254,7 +256,7 @@ impl VolumeConfig {
     /// Whether the volume comes from the very runs `timing` makes (same planner, iterations,
     /// seeds and starts), as in the demo.
     pub fn shares_runs_with(&self, timing: &TimingConfig) -> bool {
-        self.planner == ExplorePlanner::Rrt
+        self.planner == PlannerKind::Rrt
             && self.iterations == timing.iterations
             && self.seeds == timing.seeds
             && self.starts == timing.starts
@@ -272,8 +274,8 @@ pub struct Config {
     pub skip_non_finite: bool,
     /// Map types to build.
     pub types: Vec<MapKind>,
-    /// Backends each patch map is loaded into (`None`: a map file's own).
-    pub backends: Option<Vec<PatchBackend>>,
+    /// Backends each patch map is loaded into, each a patch backend (`None`: a map file's own).
+    pub backends: Option<Vec<Backend>>,
     /// Extraction preset for scans.
     pub sensor: SensorPreset,
     /// Sample spacing of a mesh's `pc` map, metres.
@@ -321,20 +323,45 @@ fn choice<T: ValueEnum>(key: &str, text: &str) -> Result<T> {
     })
 }
 
+/// One of a library vocabulary's names that `parser` accepts, or an error naming `key` and the
+/// choices.
+fn named<T: Named>(key: &str, text: &str, parser: NameParser<T>) -> Result<T> {
+    parser.parse(text).map_err(|e| anyhow::anyhow!("{key}: {e}"))
+}
+
 /// Every item of `texts` as a value enum, no repeats, at least one.
 fn choices<T: ValueEnum + PartialEq>(key: &str, texts: &[String]) -> Result<Vec<T>> {
+    list(key, texts, choice::<T>)
+}
+
+/// Every item of `texts` as a name `parser` accepts, no repeats, at least one.
+fn named_list<T: Named>(key: &str, texts: &[String], parser: NameParser<T>) -> Result<Vec<T>> {
+    list(key, texts, |k, t| named(k, t, parser))
+}
+
+/// Every item of `texts` as `one` reads it (given the item's key), no repeats, at least one.
+fn list<T: PartialEq>(
+    key: &str,
+    texts: &[String],
+    one: impl Fn(&str, &str) -> Result<T>,
+) -> Result<Vec<T>> {
     if texts.is_empty() {
         bail!("{key}: give at least one value");
     }
     let mut out: Vec<T> = Vec::with_capacity(texts.len());
     for (i, t) in texts.iter().enumerate() {
-        let v = choice::<T>(&format!("{key}[{i}]"), t)?;
+        let v = one(&format!("{key}[{i}]"), t)?;
         if out.contains(&v) {
             bail!("{key}: `{t}` is listed twice");
         }
         out.push(v);
     }
     Ok(out)
+}
+
+/// The planners `[volume]` grows ([`EXPLORE_PLANNERS`]).
+fn explore_planners() -> NameParser<PlannerKind> {
+    names::only(|k| EXPLORE_PLANNERS.contains(&k), "the volume grows the thesis's RRT or PRM")
 }
 
 /// A positive finite number of metres, or an error naming `key`.
@@ -374,8 +401,8 @@ fn point_list(key: &str, points: &[[Real; 3]]) -> Result<Vec<Point3>> {
 
 /// The maps built for `types` in `backends` (`None`: one each): one per patch type and
 /// backend, one `pc` map.
-fn map_count(input: &Input, types: &[MapKind], backends: Option<&[PatchBackend]>) -> usize {
-    let per_type = backends.map_or(1, <[PatchBackend]>::len);
+fn map_count(input: &Input, types: &[MapKind], backends: Option<&[Backend]>) -> usize {
+    let per_type = backends.map_or(1, <[Backend]>::len);
     match input {
         Input::Map(_) => per_type,
         _ => types.iter().map(|&k| if k == MapKind::Pc { 1 } else { per_type }).sum(),
@@ -532,8 +559,11 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
         }
         None => allowed.to_vec(),
     };
-    let backends =
-        m.backends.as_deref().map(|b| choices::<PatchBackend>("maps.backends", b)).transpose()?;
+    let backends = m
+        .backends
+        .as_deref()
+        .map(|b| named_list("maps.backends", b, names::patch_backends()))
+        .transpose()?;
     let sensor = match (&m.sensor, &input) {
         (Some(s), Input::Scans { .. }) => choice("maps.sensor", s)?,
         (Some(_), _) => bail!("maps.sensor applies to `scans` input only"),
@@ -580,8 +610,8 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
             p.goal_tolerance.unwrap_or(DEFAULT_GOAL_TOLERANCE),
         )?,
         planners: match &p.planners {
-            Some(names) => choices("plan.planners", names)?,
-            None => vec![PlannerChoice::Rrt, PlannerChoice::Prm],
+            Some(planners) => named_list("plan.planners", planners, names::all())?,
+            None => vec![PlannerKind::Rrt, PlannerKind::Prm],
         },
         seeds: match p.seeds {
             Some(s) if s.is_empty() => bail!("plan.seeds: give at least one seed"),
@@ -697,8 +727,8 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
             }
             Ok(VolumeConfig {
                 planner: match &v.planner {
-                    Some(p) => choice("volume.planner", p)?,
-                    None => ExplorePlanner::Rrt,
+                    Some(p) => named("volume.planner", p, explore_planners())?,
+                    None => PlannerKind::Rrt,
                 },
                 iterations: match (v.iterations, &timing) {
                     (Some(n), _) => count("volume.iterations", n, MAX_ITERATIONS_LIMIT)?,
@@ -768,7 +798,7 @@ mod tests {
         assert_eq!(c.types, vec![MapKind::Pc]);
         assert_eq!(c.name, "run");
         assert_eq!(c.plan.radius, DEFAULT_RADIUS);
-        assert_eq!(c.plan.planners, vec![PlannerChoice::Rrt, PlannerChoice::Prm]);
+        assert_eq!(c.plan.planners, vec![PlannerKind::Rrt, PlannerKind::Prm]);
         assert_eq!(c.plan.seeds, vec![1]);
         assert_eq!(c.out, dir.path().join(DEFAULT_OUT));
         assert!(c.write_3d && c.tof.is_none() && c.terrain.is_none());
@@ -819,7 +849,7 @@ mod tests {
         assert_eq!(t.seeds, (1..=demo.timing_seeds).collect::<Vec<_>>());
         assert_eq!(t.starts, vec![c.plan.start]);
         let v = c.volume.as_ref().unwrap();
-        assert_eq!((v.planner, v.cells), (ExplorePlanner::Rrt, demo.cells));
+        assert_eq!((v.planner, v.cells), (PlannerKind::Rrt, demo.cells));
         assert!(v.shares_runs_with(t));
         // Any difference in the runs, or the PRM, needs runs of its own.
         for extra in ["planner = \"prm\"", "iterations = 10", "seeds = [9]", "starts = [[0, 0, 2]]"]
@@ -887,6 +917,35 @@ mod tests {
             let e = load(&write(dir.path(), text)).unwrap_err().to_string();
             assert!(e.contains(needle) && !e.contains('\n'), "{needle}: {e}");
         }
+    }
+
+    #[test]
+    fn names_outside_a_keys_subset_are_refused_with_the_choices() {
+        let dir = tempfile::tempdir().unwrap();
+        let cases = [
+            (
+                "[input]\nscans = [\"a.ply\"]\n[maps]\nbackends = [\"rapier\", \"pointcloud\"]\n",
+                "maps.backends[1]: unknown value `pointcloud` here (it holds points, not \
+                 patches); choose one of: polygon, bbox6d, trimesh, rapier",
+            ),
+            (
+                "[input]\ncloud = \"a.ply\"\n[volume]\nplanner = \"prm-star\"\n",
+                "volume.planner: unknown value `prm-star` here (the volume grows the thesis's \
+                 RRT or PRM); choose one of: rrt, prm",
+            ),
+        ];
+        for (head, message) in cases {
+            let e = load(&write(dir.path(), &format!("{head}{PLAN}"))).unwrap_err().to_string();
+            assert!(e.ends_with(message), "{e}");
+        }
+        let text = "[input]\nmesh = \"a.obj\"\n[maps]\nbackends = [\"bbox6d\", \"trimesh\"]\n";
+        let c = load(&write(
+            dir.path(),
+            &format!("{text}{PLAN}planners = [\"prm-valid\", \"ma-rrt\"]\n"),
+        ))
+        .unwrap();
+        assert_eq!(c.backends, Some(vec![Backend::BBox6d, Backend::Trimesh]));
+        assert_eq!(c.plan.planners, [PlannerKind::PrmValid, PlannerKind::MaRrt]);
     }
 
     #[test]

@@ -8,29 +8,32 @@ use crate::demo::model::{
     DemoResults, MapDrawing, MapRow, PlanRun, SceneInfo, TerrainSection, TimingCurve, TofSection,
     VolumeSection,
 };
-use crate::demo::pipeline::explore::{Exploration, ExplorePlanner, Target, explore};
+use crate::demo::pipeline::explore::{Exploration, Target, explore};
 use crate::demo::pipeline::maps::{drawing, patch_mesh, point_map_entry};
 use crate::demo::pipeline::planning::RunRecord;
 use crate::demo::pipeline::{Clock, Files, p3, write_mesh_f32, write_ply_f32};
 use crate::extract::SensorPreset;
 use crate::input::InputArgs;
-use crate::plan::{PlannerChoice, make_planner};
+use crate::plan::make_planner;
 use crate::progress::Progress;
-use crate::scene_map::{MapKind, PatchBackend, SceneSurfaces, Tessellation, patch_map};
+use crate::scene_map::{MapKind, SceneSurfaces, Tessellation, patch_map};
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
 use patch_core::{CapsuleStep, Patch, Point3, UnspecificStepIntersector};
 use patch_map::{
-    AnyMap, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh, sample_patch_points,
+    AnyMap, Backend, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh,
+    sample_patch_points,
 };
 use pointcloud::{Aabb, PointCloud, SensorPose};
-use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PlannerStatus, PlanningSpace, Problem};
+use roadmap::{
+    AnyOf, Goal, GoalReached, MaxIterations, PlannerKind, PlannerStatus, PlanningSpace, Problem,
+};
 use std::path::Path;
 use std::time::Instant;
 
 /// The backend each patch map is loaded into when `maps.backends` is not given: the parry BVH,
 /// as the demo plans on ([`crate::demo::pipeline::maps::plan_backend`]).
-pub const DEFAULT_BACKEND: PatchBackend = PatchBackend::Trimesh;
+pub const DEFAULT_BACKEND: Backend = Backend::Trimesh;
 
 /// One map built, in one backend.
 pub struct Built {
@@ -148,7 +151,7 @@ impl Maps {
         kind: MapKind,
         patches: Vec<Patch>,
         seconds: f64,
-        backends: &[PatchBackend],
+        backends: &[Backend],
         files: &mut Files,
         write_3d: bool,
     ) -> Result<()> {
@@ -312,7 +315,9 @@ fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files
                 (Some(b), Some(patches)) => {
                     maps.add_patches(kind, patches.to_vec(), 0.0, b, files, w)?;
                 }
-                (Some(_), None) => bail!("maps.backends: a pc map stays in the pointcloud backend"),
+                (Some(_), None) => {
+                    bail!("maps.backends: a pc map stays in the {} backend", Backend::PointCloud)
+                }
                 (None, _) => maps.add_map(kind, map, 0.0, files, w)?,
             }
             bar.inc(1);
@@ -392,7 +397,7 @@ fn timing_and_volume(
     if let Some(t) = &config.timing {
         let shared = config.volume.as_ref().filter(|v| v.shares_runs_with(t));
         let (c, volume) = run(
-            ExplorePlanner::Rrt,
+            PlannerKind::Rrt,
             t.iterations,
             &t.starts,
             &t.seeds,
@@ -407,14 +412,6 @@ fn timing_and_volume(
     let Some(v) = &config.volume else { return Ok((curves, None)) };
     let (_, volume) = run(v.planner, v.iterations, &v.starts, &v.seeds, None, Some(v.cells))?;
     Ok((curves, volume))
-}
-
-/// Whether `planner` runs on `map` (the Evasion and medial-axis planners need patch maps:
-/// thesis Table 5.2).
-pub fn planner_fits(planner: PlannerChoice, map: &AnyMap) -> bool {
-    let needs_patches =
-        matches!(planner, PlannerChoice::EvasionRrt | PlannerChoice::MaPrm | PlannerChoice::MaRrt);
-    !needs_patches || map.patches().is_some()
 }
 
 /// The planning runs and the lines of runs skipped.
@@ -436,18 +433,17 @@ fn plan(
     for m in &maps.built {
         let space = PlanningSpace::new(m.map.bounds(), p.radius, p.step)
             .with_context(|| format!("the {} map's planning space", m.kind))?;
-        for &choice in &p.planners {
-            if !planner_fits(choice, &m.map) {
+        for &kind in &p.planners {
+            if !kind.runs_on(&m.map) {
                 skipped.push(format!(
-                    "{} skipped on the {} map: it needs a patch map (proximity queries or specific hits)",
-                    choice.cli_name(),
+                    "{kind} skipped on the {} map: it needs a patch map (proximity queries or specific hits)",
                     m.kind
                 ));
                 bar.inc(p.seeds.len() as u64);
                 continue;
             }
             for (k, &seed) in p.seeds.iter().enumerate() {
-                let mut run = make_planner(choice, &m.map, space, seed)?;
+                let mut run = make_planner(kind, &m.map, space, seed)?;
                 let t0 = Instant::now();
                 let status =
                     run.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(p.max_iterations)));
@@ -455,7 +451,7 @@ fn plan(
                 if status == PlannerStatus::InvalidStart {
                     bail!("plan.start is not a valid start on the {} map ({})", m.kind, run.name());
                 }
-                let name = choice.cli_name();
+                let name = kind.to_string();
                 let record = RunRecord {
                     kind: m.kind,
                     map: &m.map,

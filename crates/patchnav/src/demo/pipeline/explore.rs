@@ -16,31 +16,31 @@ use pointcloud::Aabb;
 use roadmap::metrics::quantile;
 use roadmap::volume::{CongruenceTable, VoxelGrid};
 use roadmap::{
-    MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
+    MaxIterations, Planner, PlannerKind, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
+    Rrt, RrtConfig,
 };
 
 /// Most maps one explored-volume comparison holds: the slice picture keeps one bit per map in
 /// a byte.
 pub const MAX_VOLUME_MAPS: usize = 8;
 
-/// The planner whose roadmaps are grown without a goal.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum ExplorePlanner {
-    /// Thesis Algorithm 13 ([`RrtConfig::thesis`]): Table 6.2, Fig 6.4.
-    Rrt,
-    /// Thesis Algorithm 14 ([`PrmConfig::thesis`]: six neighbours, samples unchecked):
-    /// Table 6.4.
-    Prm,
-}
+/// The planners whose roadmaps are grown without a goal: thesis Algorithm 13
+/// ([`RrtConfig::thesis`]; Table 6.2, Fig 6.4) and Algorithm 14 ([`PrmConfig::thesis`]: six
+/// neighbours, samples unchecked; Table 6.4).
+pub const EXPLORE_PLANNERS: [PlannerKind; 2] = [PlannerKind::Rrt, PlannerKind::Prm];
 
-impl ExplorePlanner {
-    /// The name in configurations and results (`rrt`, `prm`).
-    pub fn name(self) -> &'static str {
-        match self {
-            ExplorePlanner::Rrt => "rrt",
-            ExplorePlanner::Prm => "prm",
-        }
-    }
+/// The planner `kind` of [`EXPLORE_PLANNERS`] in the thesis's configuration.
+fn explorer<'m>(
+    kind: PlannerKind,
+    map: &'m AnyMap,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + 'm>> {
+    Ok(match kind {
+        PlannerKind::Rrt => Box::new(Rrt::new(map, space, RrtConfig::thesis(), seed)),
+        PlannerKind::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
+        other => bail!("an exploration grows the thesis's rrt or prm, not {other}"),
+    })
 }
 
 /// One map to explore, with its name in the results (the map type, or type and backend).
@@ -53,8 +53,8 @@ pub(crate) struct Target<'a> {
 
 /// What to grow on every map: one run per start and seed, each to `iterations`.
 pub(crate) struct Exploration<'a> {
-    /// The planner.
-    pub(crate) planner: ExplorePlanner,
+    /// The planner, one of [`EXPLORE_PLANNERS`].
+    pub(crate) planner: PlannerKind,
     /// Iterations of every run (K).
     pub(crate) iterations: u64,
     /// Starts; the slice lies at the first one's height.
@@ -110,14 +110,7 @@ pub(crate) fn explore(
         let mut timed: Vec<Vec<f64>> = Vec::new();
         for &start in e.starts {
             for &seed in e.seeds {
-                let mut run: Box<dyn Planner + '_> = match e.planner {
-                    ExplorePlanner::Rrt => {
-                        Box::new(Rrt::new(t.map, space, RrtConfig::thesis(), seed))
-                    }
-                    ExplorePlanner::Prm => {
-                        Box::new(Prm::new(t.map, space, PrmConfig::thesis(), seed))
-                    }
-                };
+                let mut run = explorer(e.planner, t.map, space, seed)?;
                 let problem = Problem { start, goals: Vec::new() };
                 let status = match &cps {
                     Some(cps) => {

@@ -8,26 +8,21 @@ use super::{
 use crate::demo::model::{MapDrawing, MapRow, P3};
 use crate::progress::Progress;
 use crate::scene_map::{
-    BuiltMap, MapKind, PatchBackend, ScanSetup, extracted_patches, patch_map, planar_triangles,
-    scan_clouds,
+    BuiltMap, MapKind, ScanSetup, extracted_patches, patch_map, planar_triangles, scan_clouds,
 };
 use anyhow::{Context, Result};
 use patch_core::triangulate::patch_triangles;
 use patch_core::{Patch, Point3};
-use patch_map::{AnyMap, PointCloudMap};
+use patch_map::{AnyMap, Backend, PointCloudMap};
 use pointcloud::PointCloud;
 use scene_sim::Scene;
 use std::time::Instant;
 
-/// The patch backends every patch map is loaded into (Table 6.1 rows).
-const PATCH_BACKENDS: [PatchBackend; 4] =
-    [PatchBackend::Polygon, PatchBackend::Bbox6d, PatchBackend::Trimesh, PatchBackend::Rapier];
-
 /// The backend each patch map type is planned on: the parry BVH (the role of the thesis's
 /// Bullet maps). A trimesh map in `polygon` or `bbox6d` pays for every triangle of each
 /// candidate patch (about 1.5 s per 300 RRT iterations on two scans' map, against 5 ms).
-pub(crate) fn plan_backend(_kind: MapKind) -> PatchBackend {
-    PatchBackend::Trimesh
+pub(crate) fn plan_backend(_kind: MapKind) -> Backend {
+    Backend::Trimesh
 }
 
 /// The scanned lab.
@@ -81,7 +76,7 @@ pub(crate) fn patch_map_row(
 ) -> Result<MapRow> {
     Ok(MapRow {
         kind: kind.name().to_owned(),
-        backend: map.backend().to_owned(),
+        backend: map.backend().to_string(),
         planar_patches: planar,
         trimesh_patches: trimesh,
         triangles,
@@ -208,7 +203,8 @@ pub(crate) fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]
 /// 3D file (`map-KIND.ply`).
 pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> Result<Built> {
     let kinds = [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh];
-    let bar = progress.bar((kinds.len() * (PATCH_BACKENDS.len() + 1) + 1) as u64, "maps");
+    let bar =
+        progress.bar((kinds.len() * (Backend::patch_backends().count() + 1) + 1) as u64, "maps");
     let mut built = Built { maps: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
     for kind in kinds {
         let t0 = Instant::now();
@@ -218,7 +214,7 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
         let extraction = t0.elapsed().as_secs_f64();
         bar.inc(1);
         let (planar, trimesh, triangles) = patch_counts(&patches)?;
-        for backend in PATCH_BACKENDS {
+        for backend in Backend::patch_backends() {
             let t1 = Instant::now();
             let map = patch_map(patches.clone(), backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
@@ -288,7 +284,7 @@ pub(crate) fn point_map_entry(
 ) -> Result<(MapRow, MapDrawing)> {
     let row = MapRow {
         kind: MapKind::Pc.name().to_owned(),
-        backend: map.backend().to_owned(),
+        backend: map.backend().to_string(),
         planar_patches: 0,
         trimesh_patches: 0,
         triangles: 0,

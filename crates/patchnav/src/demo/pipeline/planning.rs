@@ -2,7 +2,7 @@
 //! (path metrics, thesis §5.6), RRTs timed against iterations (Fig 6.4, thesis Algorithm 13
 //! as run for §6.1) and their explored volumes compared (Table 6.2, Fig 6.1).
 
-use super::explore::{Exploration, ExplorePlanner, Target, explore};
+use super::explore::{Exploration, Target, explore};
 use super::maps::Built;
 use super::{
     Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, SCAN_HEIGHT, STEP, Settings, decimate, p3, p3mm,
@@ -11,46 +11,43 @@ use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
 use crate::experiment::lab::{LabMapArgs, common_box, corner_starts};
 use crate::plan::{write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
-use crate::scene_map::{BuiltMap, MapKind, MapSource, PatchBackend};
+use crate::scene_map::{BuiltMap, MapKind, MapSource};
 use anyhow::{Context, Result, bail};
 use patch_core::Point3;
-use patch_map::AnyMap;
+use patch_map::{AnyMap, Backend};
 use roadmap::metrics::{turn_angles, upper_quartile};
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerStatus, PlanningSpace,
-    Prm, PrmConfig, Problem, Rrt, RrtConfig,
+    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlannerStatus,
+    PlanningSpace, Prm, PrmConfig, Problem, Rrt, RrtConfig,
 };
 use std::time::Instant;
 
-/// The planners run on every map type.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-enum Choice {
-    /// Goal-biased RRT.
-    Rrt,
-    /// PRM.
-    Prm,
-}
-
-/// RRT first, then PRM.
-const PLANNERS: [Choice; 2] = [Choice::Rrt, Choice::Prm];
+/// The planners run on every map type: goal-biased RRT first, then PRM.
+const PLANNERS: [PlannerKind; 2] = [PlannerKind::Rrt, PlannerKind::Prm];
 
 /// Probability that an RRT sample is an unreached goal's centre (LaValle's goal bias; the
 /// thesis's Lab runs grow without goals, its office runs test the goal directly instead).
 pub const RRT_GOAL_BIAS: f64 = 0.05;
 
-/// The planner `choice` on `map`: thesis Algorithm 13 with a goal bias of [`RRT_GOAL_BIAS`],
-/// or Algorithm 14 as the thesis configures it (six neighbours, no edge-length limit). Neither
-/// tests the direct step to a goal after each vertex (the §6.2.3 Lesum variant): in the lab
-/// the corners see each other at 1 m height, so that test alone would solve every problem
-/// without a roadmap.
-fn planner(choice: Choice, map: &AnyMap, space: PlanningSpace, seed: u64) -> Box<dyn Planner + '_> {
-    match choice {
-        Choice::Rrt => {
+/// The planner `kind` of [`PLANNERS`] on `map`: thesis Algorithm 13 with a goal bias of
+/// [`RRT_GOAL_BIAS`], or Algorithm 14 as the thesis configures it (six neighbours, no
+/// edge-length limit). Neither tests the direct step to a goal after each vertex (the §6.2.3
+/// Lesum variant): in the lab the corners see each other at 1 m height, so that test alone
+/// would solve every problem without a roadmap.
+fn planner(
+    kind: PlannerKind,
+    map: &AnyMap,
+    space: PlanningSpace,
+    seed: u64,
+) -> Result<Box<dyn Planner + '_>> {
+    Ok(match kind {
+        PlannerKind::Rrt => {
             let config = RrtConfig { goal_bias: RRT_GOAL_BIAS, ..RrtConfig::thesis() };
             Box::new(Rrt::new(map, space, config, seed))
         }
-        Choice::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
-    }
+        PlannerKind::Prm => Box::new(Prm::new(map, space, PrmConfig::thesis(), seed)),
+        other => bail!("the demo plans with rrt and prm, not {other}"),
+    })
 }
 
 /// The lab experiments' settings for what the corner search reads (radius, four corners).
@@ -64,7 +61,7 @@ fn corner_args() -> LabMapArgs {
         mesh_edge: 0.1,
         max_patch_triangles: 324,
         source: MapSource::Scans,
-        backend: PatchBackend::Trimesh,
+        backend: Backend::Trimesh,
         maps: MapKind::ALL.to_vec(),
         radius: RADIUS,
         step: STEP,
@@ -170,7 +167,7 @@ impl RunRecord<'_> {
         let c = run.counters();
         Ok(PlanRun {
             map: kind.name().to_owned(),
-            backend: self.map.backend().to_owned(),
+            backend: self.map.backend().to_string(),
             planner: self.name,
             seed: self.seed,
             solved: paths.len() == self.goals.len(),
@@ -217,10 +214,10 @@ pub(super) fn plan_all(
     let mut runs = Vec::new();
     for m in &built.maps {
         let space = space(m)?;
-        for choice in PLANNERS {
+        for kind in PLANNERS {
             for s in 0..settings.plan_seeds {
                 let run_seed = seed.wrapping_add(s);
-                let mut run = planner(choice, &m.map, space, run_seed);
+                let mut run = planner(kind, &m.map, space, run_seed)?;
                 let t0 = Instant::now();
                 let status = run.solve(
                     &problem,
@@ -267,7 +264,7 @@ pub(super) fn timing_and_volume(
         built.maps.iter().map(|m| Target { name: m.kind.name().to_owned(), map: &m.map }).collect();
     let seeds: Vec<u64> = (0..settings.timing_seeds).map(|s| seed.wrapping_add(s)).collect();
     let exploration = Exploration {
-        planner: ExplorePlanner::Rrt,
+        planner: PlannerKind::Rrt,
         iterations: settings.iterations,
         starts: &starts[..settings.timing_starts.min(starts.len())],
         seeds: &seeds,

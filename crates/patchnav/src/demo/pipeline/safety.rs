@@ -7,9 +7,9 @@
 use super::maps::{Built, drawing};
 use super::{MAX_DRAWN, RADIUS, Settings, decimate, p3mm};
 use crate::demo::model::{MapSafety, SafetySection};
-use crate::scene_map::{MapKind, PatchBackend, patch_map, truth_patches};
+use crate::scene_map::{MapKind, patch_map, truth_patches};
 use anyhow::Result;
-use patch_map::{Attribution, StepSampling, compare_maps};
+use patch_map::{Attribution, Backend, StepSampling, compare_maps};
 use scene_sim::Scene;
 
 /// Longest random step, metres.
@@ -27,7 +27,7 @@ pub(crate) fn check(
 ) -> Result<SafetySection> {
     let truth_patches = truth_patches(scene)?;
     let truth_drawing = drawing(MapKind::Planes, &truth_patches);
-    let truth = patch_map(truth_patches, PatchBackend::Bbox6d)?;
+    let truth = patch_map(truth_patches, Backend::BBox6d)?;
     let sampling = StepSampling {
         radius: RADIUS,
         max_length: MAX_LENGTH,

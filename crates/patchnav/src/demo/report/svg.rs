@@ -4,6 +4,7 @@
 use super::html::{esc, sig};
 use super::raster::{hex, map_colour};
 use crate::demo::model::{MapDrawing, P3, PlanRun, TimingCurve};
+use roadmap::PlannerKind;
 use std::fmt::Write as _;
 
 /// Width the pictures are drawn at, pixels.
@@ -13,13 +14,13 @@ const MAX_HEIGHT: f64 = 640.0;
 /// Margin around the drawing, pixels.
 const MARGIN: f64 = 12.0;
 
-/// Colour of a planner's roadmap and path: fixed for `rrt` and `prm`, others from a palette by
-/// a hash of the name (so every picture and the legend agree).
+/// Colour of a planner's roadmap and path (by the name it reports): fixed for the RRT and the
+/// PRM, others from a palette by a hash of the name (so every picture and the legend agree).
 pub fn planner_colour(planner: &str) -> &'static str {
     const PALETTE: [&str; 4] = ["#8c564b", "#e377c2", "#17becf", "#bcbd22"];
-    match planner {
-        "rrt" => "#d95f02",
-        "prm" => "#7b3294",
+    match planner.parse() {
+        Ok(PlannerKind::Rrt) => "#d95f02",
+        Ok(PlannerKind::Prm) => "#7b3294",
         _ => PALETTE[planner.bytes().map(usize::from).sum::<usize>() % PALETTE.len()],
     }
 }
