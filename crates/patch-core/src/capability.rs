@@ -50,7 +50,7 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::step::Step;
+use crate::step::{CapsuleStep, Step};
 use crate::{Aabb, MapError, Patch, Point3, Real, UnitVector3};
 
 /// The identity of a patch in a map: its insertion index, dense from 0.
@@ -183,8 +183,9 @@ pub trait ProximityQuery: PatchMap {
 /// Table 5.2).
 ///
 /// See the [module docs](self) for the contract: never reports a colliding step as free; may
-/// report a free step as colliding only within the backend's conservative margin.
-pub trait UnspecificStepIntersector<S: Step> {
+/// report a free step as colliding only within the backend's conservative margin. The step
+/// type defaults to [`CapsuleStep`], the robot's motion the planners test.
+pub trait UnspecificStepIntersector<S: Step = CapsuleStep> {
     /// Whether no patch comes within the step's radius of its segment.
     fn is_step_free(&self, step: &S) -> bool;
 }
@@ -196,7 +197,9 @@ pub trait UnspecificStepIntersector<S: Step> {
 /// a faster any-hit test (OMPL's motion validator bisects for the boolean and walks for the
 /// first failure). Backends without one write the unspecific half with
 /// [`is_step_free_via_first_hit`].
-pub trait SpecificStepIntersector<S: Step>: UnspecificStepIntersector<S> + PatchMap {
+pub trait SpecificStepIntersector<S: Step = CapsuleStep>:
+    UnspecificStepIntersector<S> + PatchMap
+{
     /// The first contact along the step, or `None` if it is free (see the module docs for the
     /// tolerance statements).
     fn first_hit(&self, step: &S) -> Option<StepHit>;
@@ -304,10 +307,7 @@ mod tests {
 
     fn full<M>()
     where
-        M: PatchMap
-            + ProximityQuery
-            + SpecificStepIntersector<LineStep>
-            + SpecificStepIntersector<CapsuleStep>,
+        M: PatchMap + ProximityQuery + SpecificStepIntersector<LineStep> + SpecificStepIntersector,
     {
     }
     fn mutable<M: PatchMapMut + FromPatches>() {}

@@ -85,8 +85,8 @@ fn bench_point_cloud(c: &mut Criterion, scene: &Scene) {
 /// Everything a benchmarked backend answers.
 trait Backend:
     FromPatches
-    + UnspecificStepIntersector<CapsuleStep>
-    + SpecificStepIntersector<CapsuleStep>
+    + UnspecificStepIntersector
+    + SpecificStepIntersector
     + UnspecificStepIntersector<LineStep>
     + SpecificStepIntersector<LineStep>
 {
@@ -94,8 +94,8 @@ trait Backend:
 
 impl<M> Backend for M where
     M: FromPatches
-        + UnspecificStepIntersector<CapsuleStep>
-        + SpecificStepIntersector<CapsuleStep>
+        + UnspecificStepIntersector
+        + SpecificStepIntersector
         + UnspecificStepIntersector<LineStep>
         + SpecificStepIntersector<LineStep>
 {

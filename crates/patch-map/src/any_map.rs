@@ -172,7 +172,7 @@ impl MaybePatchMap for AnyMap {
 
 /// Every backend answers the unspecific capsule query (with its own tolerance: the point-cloud
 /// map under its density assumption).
-impl UnspecificStepIntersector<CapsuleStep> for AnyMap {
+impl UnspecificStepIntersector for AnyMap {
     fn is_step_free(&self, step: &CapsuleStep) -> bool {
         match self {
             AnyMap::Polygon(m) => m.is_step_free(step),

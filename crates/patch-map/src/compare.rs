@@ -305,7 +305,7 @@ impl<'m> PatchMapVisitor<'m> for FirstContact<'_> {
     type Output = Option<(PatchId, Point3)>;
     fn visit<M>(self, map: &'m M) -> Self::Output
     where
-        M: ProximityQuery + SpecificStepIntersector<CapsuleStep>,
+        M: ProximityQuery + SpecificStepIntersector,
     {
         map.first_hit(self.0).map(|h| (h.patch, h.point))
     }
@@ -320,8 +320,8 @@ pub fn compare_on_steps<T, M>(
     attribution: Attribution,
 ) -> MapComparison
 where
-    T: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
-    M: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
+    T: UnspecificStepIntersector + MaybePatchMap + Sync,
+    M: UnspecificStepIntersector + MaybePatchMap + Sync,
 {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 64);
     let chunk = steps.len().div_ceil(threads).max(1);
@@ -387,8 +387,8 @@ pub fn compare_maps<T, M>(
     attribution: Attribution,
 ) -> Result<MapComparison, CompareError>
 where
-    T: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
-    M: UnspecificStepIntersector<CapsuleStep> + MaybePatchMap + Sync,
+    T: UnspecificStepIntersector + MaybePatchMap + Sync,
+    M: UnspecificStepIntersector + MaybePatchMap + Sync,
 {
     let steps = random_steps(sampling)?;
     Ok(compare_on_steps(truth, test, &steps, attribution))

@@ -234,7 +234,7 @@ impl PointCloudMap {
 /// radius; exact against the points, conservative by at most about
 /// `MIN_ADVANCE² / (2r)` for grazing steps, and a check against the sampled *surface* only
 /// under the density assumption of the [module docs](self).
-impl UnspecificStepIntersector<CapsuleStep> for PointCloudMap {
+impl UnspecificStepIntersector for PointCloudMap {
     fn is_step_free(&self, step: &CapsuleStep) -> bool {
         self.capsule_is_free(&step.start(), &step.end(), step.radius())
     }

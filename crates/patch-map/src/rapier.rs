@@ -312,7 +312,7 @@ impl SpecificStepIntersector<LineStep> for RapierMap {
     }
 }
 
-impl UnspecificStepIntersector<CapsuleStep> for RapierMap {
+impl UnspecificStepIntersector for RapierMap {
     /// Any-hit over the colliders, closed-form segment–triangle distances in each (see the
     /// [module docs](self)).
     fn is_step_free(&self, step: &CapsuleStep) -> bool {
@@ -320,7 +320,7 @@ impl UnspecificStepIntersector<CapsuleStep> for RapierMap {
     }
 }
 
-impl SpecificStepIntersector<CapsuleStep> for RapierMap {
+impl SpecificStepIntersector for RapierMap {
     /// Best-first over the colliders, ball casts in each (see the [module docs](self)).
     fn first_hit(&self, step: &CapsuleStep) -> Option<StepHit> {
         self.first(step)

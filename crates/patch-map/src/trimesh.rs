@@ -910,7 +910,7 @@ impl SpecificStepIntersector<LineStep> for TrimeshMap {
     }
 }
 
-impl UnspecificStepIntersector<CapsuleStep> for TrimeshMap {
+impl UnspecificStepIntersector for TrimeshMap {
     /// Closed-form segment–triangle distances on the triangles near the segment (see the
     /// [module docs](self)).
     fn is_step_free(&self, step: &CapsuleStep) -> bool {
@@ -918,7 +918,7 @@ impl UnspecificStepIntersector<CapsuleStep> for TrimeshMap {
     }
 }
 
-impl SpecificStepIntersector<CapsuleStep> for TrimeshMap {
+impl SpecificStepIntersector for TrimeshMap {
     /// parry's ball cast on the triangles within the radius (see the [module docs](self)).
     fn first_hit(&self, step: &CapsuleStep) -> Option<StepHit> {
         self.first(step)

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_core::{Point3, Real, UnspecificStepIntersector};
 use petgraph::graph::NodeIndex;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -35,15 +35,15 @@ use crate::termination::Termination;
 /// The roadmap holds every tree (a forest until they join); vertices of a goal tree count as
 /// explored (for [`PlannerStatus::Approximate`]) only once joined.
 ///
-/// Needs only [`UnspecificStepIntersector<CapsuleStep>`].
-pub struct RrtConnect<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+/// Needs only [`UnspecificStepIntersector`].
+pub struct RrtConnect<'m, M: UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     seed: u64,
     solution: Solution,
 }
 
-impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtConnect<'m, M> {
+impl<'m, M: UnspecificStepIntersector + ?Sized> RrtConnect<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, seed: u64) -> Self {
         RrtConnect { map, space, seed, solution: Solution::default() }
@@ -55,7 +55,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtConnect<'m, M> {
     }
 }
 
-impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for RrtConnect<'_, M> {
+impl<M: UnspecificStepIntersector + ?Sized> Planner for RrtConnect<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::RrtConnect.name()
     }
@@ -126,7 +126,7 @@ enum Step {
 }
 
 /// One RRT step of tree `tree` toward `x` (nothing for a zero-length step).
-fn extend<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn extend<M: UnspecificStepIntersector + ?Sized>(
     state: &mut State<'_>,
     checker: &mut Checker<'_, M>,
     space: &PlanningSpace,
@@ -151,7 +151,7 @@ fn extend<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 
 /// Tree `tree` steps toward vertex `target` of the other tree until it joins it (returns
 /// `true`) or a step collides.
-fn connect<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn connect<M: UnspecificStepIntersector + ?Sized>(
     state: &mut State<'_>,
     checker: &mut Checker<'_, M>,
     space: &PlanningSpace,
@@ -175,7 +175,7 @@ fn connect<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
     }
 }
 
-fn solve_connect<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn solve_connect<M: UnspecificStepIntersector + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     seed: u64,

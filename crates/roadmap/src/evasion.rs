@@ -1,8 +1,6 @@
 //! The Evasion RRT (thesis §5.5.1, Algorithm 11, as repaired by spec §4 [R]).
 
-use patch_core::{
-    CapsuleStep, Patch, PatchId, Point3, Real, SpecificStepIntersector, UnitVector3, Vector3,
-};
+use patch_core::{Patch, PatchId, Point3, Real, SpecificStepIntersector, UnitVector3, Vector3};
 
 use crate::planner::{
     Checker, Contact, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution,
@@ -63,7 +61,7 @@ impl EvasionRrtConfig {
 /// The shifts are perpendicular to `u`, so an edge is at most
 /// `sqrt(max_step² + (E · l_ev)²)` long.
 ///
-/// Needs [`SpecificStepIntersector<CapsuleStep>`] (thesis Table 5.2); a map with only the
+/// Needs [`SpecificStepIntersector`] (thesis Table 5.2); a map with only the
 /// unspecific query is rejected at compile time:
 ///
 /// ```
@@ -81,7 +79,7 @@ impl EvasionRrtConfig {
 /// use roadmap::{EvasionRrt, EvasionRrtConfig, PlanningSpace};
 ///
 /// struct OnlyUnspecific;
-/// impl UnspecificStepIntersector<CapsuleStep> for OnlyUnspecific {
+/// impl UnspecificStepIntersector for OnlyUnspecific {
 ///     fn is_step_free(&self, _: &CapsuleStep) -> bool { true }
 /// }
 /// let bounds = Aabb::new(Point3::origin(), Point3::new(4.0, 4.0, 2.0));
@@ -91,7 +89,7 @@ impl EvasionRrtConfig {
 /// ```
 ///
 /// [`Rrt`]: crate::Rrt
-pub struct EvasionRrt<'m, M: SpecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct EvasionRrt<'m, M: SpecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: EvasionRrtConfig,
@@ -100,7 +98,7 @@ pub struct EvasionRrt<'m, M: SpecificStepIntersector<CapsuleStep> + ?Sized> {
     evaded: usize,
 }
 
-impl<'m, M: SpecificStepIntersector<CapsuleStep> + ?Sized> EvasionRrt<'m, M> {
+impl<'m, M: SpecificStepIntersector + ?Sized> EvasionRrt<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: EvasionRrtConfig, seed: u64) -> Self {
         EvasionRrt { map, space, config, seed, solution: Solution::default(), evaded: 0 }
@@ -122,7 +120,7 @@ impl<'m, M: SpecificStepIntersector<CapsuleStep> + ?Sized> EvasionRrt<'m, M> {
     }
 }
 
-impl<M: SpecificStepIntersector<CapsuleStep> + ?Sized> Planner for EvasionRrt<'_, M> {
+impl<M: SpecificStepIntersector + ?Sized> Planner for EvasionRrt<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::EvasionRrt.name()
     }

@@ -10,24 +10,24 @@
 //!
 //! | planner | capability of the map | here |
 //! |---|---|---|
-//! | RRT (Alg. 13) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Rrt`] |
-//! | PRM (Alg. 14) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] |
-//! | PRM* (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`Prm`] with [`PrmConfig::star()`] |
-//! | lazy PRM (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`LazyPrm`] (any [`PrmConfig`]) |
-//! | RRT* (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtStar`] |
-//! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector<CapsuleStep>`] | [`EvasionRrt`] |
-//! | MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaPrm`] |
-//! | MA RRT (§5.5.2, no pseudo-code) | [`ProximityQuery`] + [`UnspecificStepIntersector<CapsuleStep>`] | [`MaRrt`] |
-//! | RRT-Connect (not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`RrtConnect`] |
-//! | path shortcutting (post-process, not in the thesis) | [`UnspecificStepIntersector<CapsuleStep>`] | [`shortcut_path`] |
+//! | RRT (Alg. 13) | [`UnspecificStepIntersector`] | [`Rrt`] |
+//! | PRM (Alg. 14) | [`UnspecificStepIntersector`] | [`Prm`] |
+//! | PRM* (not in the thesis) | [`UnspecificStepIntersector`] | [`Prm`] with [`PrmConfig::star()`] |
+//! | lazy PRM (not in the thesis) | [`UnspecificStepIntersector`] | [`LazyPrm`] (any [`PrmConfig`]) |
+//! | RRT* (not in the thesis) | [`UnspecificStepIntersector`] | [`RrtStar`] |
+//! | Evasion RRT (Alg. 11) | [`SpecificStepIntersector`] | [`EvasionRrt`] |
+//! | MA PRM (Alg. 12) | [`ProximityQuery`] + [`UnspecificStepIntersector`] | [`MaPrm`] |
+//! | MA RRT (§5.5.2, no pseudo-code) | [`ProximityQuery`] + [`UnspecificStepIntersector`] | [`MaRrt`] |
+//! | RRT-Connect (not in the thesis) | [`UnspecificStepIntersector`] | [`RrtConnect`] |
+//! | path shortcutting (post-process, not in the thesis) | [`UnspecificStepIntersector`] | [`shortcut_path`] |
 //!
 //! A planner states its capability as a trait bound, so a map without it is rejected at
 //! compile time: the point-cloud map (`PointCloudMap` of `patch-map`), which answers no
 //! closest-patch queries, runs the RRT, PRM, RRT*, lazy PRM and RRT-Connect (and path
 //! shortcutting) but not the medial-axis planners (thesis Table 5.2).
 //!
-//! [`UnspecificStepIntersector<CapsuleStep>`]: patch_core::UnspecificStepIntersector
-//! [`SpecificStepIntersector<CapsuleStep>`]: patch_core::SpecificStepIntersector
+//! [`UnspecificStepIntersector`]: patch_core::UnspecificStepIntersector
+//! [`SpecificStepIntersector`]: patch_core::SpecificStepIntersector
 //! [`ProximityQuery`]: patch_core::ProximityQuery
 //!
 //! # Design (OMPL's separation)

@@ -6,16 +6,14 @@
 //! (`d_P1(q) = d_P2(q)`); the thesis retracts samples onto it without computing it, which is
 //! simpler than the retraction of Wilmarth et al. (1999) because the patches are the border of free space.
 //!
-//! These planners need [`ProximityQuery`] besides [`UnspecificStepIntersector<CapsuleStep>`]
+//! These planners need [`ProximityQuery`] besides [`UnspecificStepIntersector`]
 //! (thesis Table 5.2): a map without closest-patch queries, such as the point-cloud map
 //! (`PointCloudMap` of the `patch-map` crate), cannot run them and is rejected at compile time.
 
 use std::cell::Cell;
 use std::time::{Duration, Instant};
 
-use patch_core::{
-    Aabb, CapsuleStep, Point3, Proximity, ProximityQuery, Real, UnspecificStepIntersector,
-};
+use patch_core::{Aabb, Point3, Proximity, ProximityQuery, Real, UnspecificStepIntersector};
 use rand_chacha::ChaCha8Rng;
 
 use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
@@ -203,7 +201,7 @@ impl MaPrmConfig {
 /// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`](crate::PlannerCounters::proximity_queries) (not in
 /// [`PlannerCounters::collision_checks`](crate::PlannerCounters::collision_checks)).
 ///
-/// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
+/// Needs [`ProximityQuery`] and [`UnspecificStepIntersector`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) is rejected at
 /// compile time:
 ///
@@ -222,7 +220,7 @@ impl MaPrmConfig {
 /// use roadmap::{MaPrm, MaPrmConfig, PlanningSpace};
 ///
 /// struct OnlyUnspecific;
-/// impl UnspecificStepIntersector<CapsuleStep> for OnlyUnspecific {
+/// impl UnspecificStepIntersector for OnlyUnspecific {
 ///     fn is_step_free(&self, _: &CapsuleStep) -> bool { true }
 /// }
 /// let bounds = Aabb::new(Point3::origin(), Point3::new(4.0, 4.0, 2.0));
@@ -234,7 +232,7 @@ impl MaPrmConfig {
 /// # Complexity
 /// Per iteration `O(log(L/τ))` closest-patch queries (see [`retract_to_medial_axis`]) plus the
 /// PRM's neighbour query and at most `N` capsule checks.
-pub struct MaPrm<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct MaPrm<'m, M: ProximityQuery + UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: MaPrmConfig,
@@ -242,7 +240,7 @@ pub struct MaPrm<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> 
     solution: Solution,
 }
 
-impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> MaPrm<'m, M> {
+impl<'m, M: ProximityQuery + UnspecificStepIntersector + ?Sized> MaPrm<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: MaPrmConfig, seed: u64) -> Self {
         MaPrm { map, space, config, seed, solution: Solution::default() }
@@ -259,7 +257,7 @@ impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Ma
     }
 }
 
-impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for MaPrm<'_, M> {
+impl<M: ProximityQuery + UnspecificStepIntersector + ?Sized> Planner for MaPrm<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::MaPrm.name()
     }
@@ -318,9 +316,9 @@ impl MaRrtConfig {
 /// Closest-patch queries are counted in [`PlannerCounters::proximity_queries`](crate::PlannerCounters::proximity_queries) (not in
 /// [`PlannerCounters::collision_checks`](crate::PlannerCounters::collision_checks)).
 ///
-/// Needs [`ProximityQuery`] and [`UnspecificStepIntersector<CapsuleStep>`] (thesis
+/// Needs [`ProximityQuery`] and [`UnspecificStepIntersector`] (thesis
 /// Table 5.2); a map without closest-patch queries (the point-cloud map) cannot run it.
-pub struct MaRrt<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct MaRrt<'m, M: ProximityQuery + UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: MaRrtConfig,
@@ -328,7 +326,7 @@ pub struct MaRrt<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> 
     solution: Solution,
 }
 
-impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> MaRrt<'m, M> {
+impl<'m, M: ProximityQuery + UnspecificStepIntersector + ?Sized> MaRrt<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: MaRrtConfig, seed: u64) -> Self {
         MaRrt { map, space, config, seed, solution: Solution::default() }
@@ -345,7 +343,7 @@ impl<'m, M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Ma
     }
 }
 
-impl<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for MaRrt<'_, M> {
+impl<M: ProximityQuery + UnspecificStepIntersector + ?Sized> Planner for MaRrt<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::MaRrt.name()
     }

@@ -27,7 +27,7 @@ use crate::{
     Prm, PrmConfig, Rrt, RrtConfig, RrtConnect, RrtStar, RrtStarConfig,
 };
 use patch_core::{
-    CapsuleStep, MaybePatchMap, PatchMapVisitor, ProximityQuery, SpecificStepIntersector,
+    MaybePatchMap, PatchMapVisitor, ProximityQuery, SpecificStepIntersector,
     UnspecificStepIntersector,
 };
 use std::fmt;
@@ -208,7 +208,7 @@ impl<'m> PatchMapVisitor<'m> for Offers {
 
     fn visit<M>(self, _map: &'m M) -> Self::Output
     where
-        M: ProximityQuery + SpecificStepIntersector<CapsuleStep>,
+        M: ProximityQuery + SpecificStepIntersector,
     {
     }
 }
@@ -255,7 +255,7 @@ pub fn named_planner<'m, M>(
     seed: u64,
 ) -> Result<Box<dyn Planner + 'm>, NamedPlannerError>
 where
-    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: UnspecificStepIntersector + ?Sized,
 {
     step_test_planner(kind, map, space, seed)
         .map_err(|capability| NamedPlannerError::NeedsCapability { planner: kind, capability })
@@ -270,7 +270,7 @@ pub fn named_patch_planner<'m, M>(
     seed: u64,
 ) -> Box<dyn Planner + 'm>
 where
-    M: ProximityQuery + SpecificStepIntersector<CapsuleStep> + ?Sized,
+    M: ProximityQuery + SpecificStepIntersector + ?Sized,
 {
     match step_test_planner(kind, map, space, seed) {
         Ok(planner) => planner,
@@ -307,7 +307,7 @@ pub fn named_planner_on<'m, M>(
     seed: u64,
 ) -> Result<Box<dyn Planner + 'm>, NamedPlannerError>
 where
-    M: MaybePatchMap + UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: MaybePatchMap + UnspecificStepIntersector + ?Sized,
 {
     let Some(capability) = kind.needs() else {
         return named_planner(kind, map, space, seed);
@@ -329,7 +329,7 @@ impl<'m> PatchMapVisitor<'m> for PatchPlanner {
 
     fn visit<M>(self, map: &'m M) -> Self::Output
     where
-        M: ProximityQuery + SpecificStepIntersector<CapsuleStep>,
+        M: ProximityQuery + SpecificStepIntersector,
     {
         named_patch_planner(self.kind, map, self.space, self.seed)
     }
@@ -343,7 +343,7 @@ fn step_test_planner<'m, M>(
     seed: u64,
 ) -> Result<Box<dyn Planner + 'm>, MapCapability>
 where
-    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: UnspecificStepIntersector + ?Sized,
 {
     Ok(match kind {
         PlannerKind::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
@@ -441,8 +441,8 @@ mod tests {
         Points(BruteForceMap),
     }
 
-    impl UnspecificStepIntersector<CapsuleStep> for RunTimeMap {
-        fn is_step_free(&self, step: &CapsuleStep) -> bool {
+    impl UnspecificStepIntersector for RunTimeMap {
+        fn is_step_free(&self, step: &patch_core::CapsuleStep) -> bool {
             match self {
                 RunTimeMap::Patches(m) | RunTimeMap::Points(m) => m.is_step_free(step),
             }

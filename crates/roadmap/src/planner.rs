@@ -99,7 +99,7 @@ pub(crate) struct Checker<'a, M: ?Sized> {
     time: Duration,
 }
 
-impl<'a, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Checker<'a, M> {
+impl<'a, M: UnspecificStepIntersector + ?Sized> Checker<'a, M> {
     pub(crate) fn new(map: &'a M, radius: Real) -> Self {
         Checker { map, radius, checks: 0, time: Duration::ZERO }
     }
@@ -128,7 +128,7 @@ pub(crate) enum Contact {
     Invalid,
 }
 
-impl<'a, M: SpecificStepIntersector<CapsuleStep> + ?Sized> Checker<'a, M> {
+impl<'a, M: SpecificStepIntersector + ?Sized> Checker<'a, M> {
     /// The first contact of the robot's capsule from `a` to `b`, counted and timed as one
     /// collision check.
     pub(crate) fn first_hit(&mut self, a: &Point3, b: &Point3) -> Contact {
@@ -155,7 +155,7 @@ pub(crate) fn validate<M>(
     checker: &mut Checker<'_, M>,
 ) -> Option<PlannerStatus>
 where
-    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: UnspecificStepIntersector + ?Sized,
 {
     let bounds = space.bounds();
     let valid = |p: &Point3, checker: &mut Checker<'_, M>| {

@@ -4,7 +4,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::time::Instant;
 
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_core::{Point3, Real, UnspecificStepIntersector};
 use petgraph::graph::NodeIndex;
 use petgraph::unionfind::UnionFind;
 use petgraph::visit::Bfs;
@@ -110,12 +110,12 @@ impl PrmConfig {
 ///
 /// A goal is reached once some vertex within its tolerance is in the start's component.
 ///
-/// Needs only [`UnspecificStepIntersector<CapsuleStep>`] (thesis Table 5.2).
+/// Needs only [`UnspecificStepIntersector`] (thesis Table 5.2).
 ///
 /// # Complexity
 /// Per iteration a [`KdNeighbors`] query for the neighbours plus at most `N` (PRM*: `k(n)`,
 /// `O(log n)`) capsule checks (plus one per goal without a vertex, with the direct goal step).
-pub struct Prm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct Prm<'m, M: UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: PrmConfig,
@@ -125,7 +125,7 @@ pub struct Prm<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
     solution: Solution,
 }
 
-impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
+impl<'m, M: UnspecificStepIntersector + ?Sized> Prm<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> Self {
         Prm { map, space, config, seed, lazy: false, solution: Solution::default() }
@@ -153,7 +153,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Prm<'m, M> {
     }
 }
 
-impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> {
+impl<M: UnspecificStepIntersector + ?Sized> Planner for Prm<'_, M> {
     /// The name of the [`PlannerKind`](crate::PlannerKind) this configuration is, or
     /// `lazy-prm-star`, which has none.
     fn name(&self) -> &'static str {
@@ -222,7 +222,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Prm<'_, M> 
 /// contract: an edge is a motion found free), so [`PlannerCounters::edges`](crate::PlannerCounters::edges) counts those;
 /// [`Planner::path_to`] returns the shortest path over them.
 ///
-/// Needs only [`UnspecificStepIntersector<CapsuleStep>`].
+/// Needs only [`UnspecificStepIntersector`].
 ///
 /// # Complexity
 /// Per iteration a [`KdNeighbors`] query; per query round a Dijkstra search over the
@@ -407,7 +407,7 @@ impl Ord for Queued {
 /// the next vertex, or `None` to drop the iteration's sample (it still counts as an
 /// iteration).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+pub(crate) fn solve_prm<M: UnspecificStepIntersector + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     config: &PrmConfig,
@@ -485,7 +485,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 
 /// With the direct goal step: connects `v` to the centre of each unreached goal that has no
 /// vertex yet, if the capsule is free.
-fn direct_goal_steps<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn direct_goal_steps<M: UnspecificStepIntersector + ?Sized>(
     solution: &mut Solution,
     forest: &mut Forest,
     checker: &mut Checker<'_, M>,
@@ -510,7 +510,7 @@ fn direct_goal_steps<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 
 /// Marks goals whose nearby vertices joined the start's component (lazily: for which a query
 /// finds a path of edges checked free).
-fn update_reached<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn update_reached<M: UnspecificStepIntersector + ?Sized>(
     solution: &mut Solution,
     forest: &mut Forest,
     checker: &mut Checker<'_, M>,
@@ -544,7 +544,7 @@ fn update_reached<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 
 /// The query of the lazy PRM for goal `g` (see [`LazyPrm`]): the vertex near the goal at the
 /// end of a path from the start whose edges are all checked free, or `None`.
-fn lazy_query<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn lazy_query<M: UnspecificStepIntersector + ?Sized>(
     solution: &mut Solution,
     forest: &mut Forest,
     checker: &mut Checker<'_, M>,

@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_core::{Point3, Real, UnspecificStepIntersector};
 use petgraph::graph::NodeIndex;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -75,13 +75,13 @@ impl RrtConfig {
 /// goal is tested: it is reached if the vertex lies within its tolerance, or (with
 /// [`RrtConfig::direct_goal_step`]) if the capsule from the vertex to the goal centre is free.
 ///
-/// Needs only [`UnspecificStepIntersector<CapsuleStep>`] (thesis Table 5.2).
+/// Needs only [`UnspecificStepIntersector`] (thesis Table 5.2).
 ///
 /// # Complexity
 /// Nearest neighbours come from [`KdNeighbors`] (amortised O(log² n) per added vertex,
 /// O(log² n) per query) on top of one capsule check per iteration (plus one per unreached
 /// goal with the direct goal step).
-pub struct Rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct Rrt<'m, M: UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: RrtConfig,
@@ -89,7 +89,7 @@ pub struct Rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
     solution: Solution,
 }
 
-impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Rrt<'m, M> {
+impl<'m, M: UnspecificStepIntersector + ?Sized> Rrt<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: RrtConfig, seed: u64) -> Self {
         Rrt { map, space, config, seed, solution: Solution::default() }
@@ -106,7 +106,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Rrt<'m, M> {
     }
 }
 
-impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> {
+impl<M: UnspecificStepIntersector + ?Sized> Planner for Rrt<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::Rrt.name()
     }
@@ -131,7 +131,7 @@ impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for Rrt<'_, M> 
 /// with an edge to `x_near` (`x_new` itself for the plain RRT, a shifted point for the Evasion
 /// RRT), or `None` if the extension is Trapped.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector + ?Sized>(
     map: &'m M,
     space: &PlanningSpace,
     config: &RrtConfig,
@@ -182,7 +182,7 @@ pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 }
 
 /// Tests every unreached goal against the new vertex `v` (all vertices are in the start's tree).
-fn test_goals<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn test_goals<M: UnspecificStepIntersector + ?Sized>(
     solution: &mut Solution,
     nn: &mut KdNeighbors,
     checker: &mut Checker<'_, M>,

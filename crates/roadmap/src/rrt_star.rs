@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
+use patch_core::{Point3, Real, UnspecificStepIntersector};
 use petgraph::graph::NodeIndex;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -87,13 +87,13 @@ impl RrtStarConfig {
 /// solution like the other planners, with [`MaxIterations`](crate::MaxIterations) it keeps
 /// improving it (costs never increase).
 ///
-/// Needs only [`UnspecificStepIntersector<CapsuleStep>`].
+/// Needs only [`UnspecificStepIntersector`].
 ///
 /// # Complexity
 /// Per iteration a nearest and a `k(n)`-nearest [`KdNeighbors`] query (`k(n) = O(log n)`),
 /// one capsule check for the steer step plus at most `2·k(n)` more (usually far fewer), and
 /// the cost update of the rewired subtrees.
-pub struct RrtStar<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
+pub struct RrtStar<'m, M: UnspecificStepIntersector + ?Sized> {
     map: &'m M,
     space: PlanningSpace,
     config: RrtStarConfig,
@@ -102,7 +102,7 @@ pub struct RrtStar<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> {
     tree: Tree,
 }
 
-impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtStar<'m, M> {
+impl<'m, M: UnspecificStepIntersector + ?Sized> RrtStar<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: RrtStarConfig, seed: u64) -> Self {
         RrtStar { map, space, config, seed, solution: Solution::default(), tree: Tree::default() }
@@ -131,7 +131,7 @@ impl<'m, M: UnspecificStepIntersector<CapsuleStep> + ?Sized> RrtStar<'m, M> {
     }
 }
 
-impl<M: UnspecificStepIntersector<CapsuleStep> + ?Sized> Planner for RrtStar<'_, M> {
+impl<M: UnspecificStepIntersector + ?Sized> Planner for RrtStar<'_, M> {
     fn name(&self) -> &'static str {
         crate::PlannerKind::RrtStar.name()
     }
@@ -261,7 +261,7 @@ struct Candidate {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn solve_rrt_star<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn solve_rrt_star<M: UnspecificStepIntersector + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     config: &RrtStarConfig,
@@ -367,7 +367,7 @@ fn solve_rrt_star<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
 
 /// With the direct goal step: connects `v` to the centre of each unreached goal that has no
 /// vertex yet, if the capsule is free.
-fn direct_goal_steps<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+fn direct_goal_steps<M: UnspecificStepIntersector + ?Sized>(
     solution: &mut Solution,
     tree: &mut Tree,
     checker: &mut Checker<'_, M>,

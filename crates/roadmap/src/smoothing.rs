@@ -55,7 +55,7 @@ impl ShortcutConfig {
 /// The greedy pass makes at most `n(n − 1)/2` capsule checks for `n` vertices (fewer the more
 /// it shortcuts) and each random attempt at most three; every free candidate costs `O(n)` to
 /// measure.
-pub fn shortcut_path<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+pub fn shortcut_path<M: UnspecificStepIntersector + ?Sized>(
     map: &M,
     path: &[Point3],
     radius: Real,

@@ -117,7 +117,7 @@ pub enum VolumeError {
 /// [`StepError`] for a radius that is not positive and finite.
 pub fn explored_part<M>(roadmap: &Roadmap, map: &M, radius: Real) -> Result<Roadmap, StepError>
 where
-    M: UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: UnspecificStepIntersector + ?Sized,
 {
     let mut free = Vec::with_capacity(roadmap.node_count());
     for v in roadmap.node_indices() {

@@ -315,7 +315,7 @@ pub fn check_clearance_vs_capsule<M>(
     tolerance: Tolerance,
 ) -> Result<(), TestCaseError>
 where
-    M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized,
+    M: ProximityQuery + UnspecificStepIntersector + ?Sized,
 {
     let (eps, delta) = (tolerance.numeric, tolerance.conservative);
     let clearance = map.clearance(point, Real::INFINITY);

@@ -19,8 +19,8 @@ use super::strategies::{
     scene, scene_with_capsule_steps, scene_with_line_steps, scene_with_points,
 };
 use crate::{
-    BruteForceMap, CapsuleStep, FromPatches, LineStep, Patch, PatchId, PatchMap, PatchMapMut,
-    ProximityQuery, Real, SpecificStepIntersector, UnspecificStepIntersector,
+    BruteForceMap, FromPatches, LineStep, Patch, PatchId, PatchMap, PatchMapMut, ProximityQuery,
+    Real, SpecificStepIntersector, UnspecificStepIntersector,
 };
 
 const PATCHES: std::ops::RangeInclusive<usize> = 0..=6;
@@ -127,10 +127,8 @@ pub fn line_specific<M: FromPatches + SpecificStepIntersector<LineStep>>(config:
     );
 }
 
-/// [`UnspecificStepIntersector<CapsuleStep>`] ([`check_unspecific`]).
-pub fn capsule_unspecific<M: FromPatches + UnspecificStepIntersector<CapsuleStep>>(
-    config: &SuiteConfig,
-) {
+/// [`UnspecificStepIntersector`] ([`check_unspecific`]).
+pub fn capsule_unspecific<M: FromPatches + UnspecificStepIntersector>(config: &SuiteConfig) {
     run(
         config,
         "capsule_unspecific",
@@ -142,10 +140,8 @@ pub fn capsule_unspecific<M: FromPatches + UnspecificStepIntersector<CapsuleStep
     );
 }
 
-/// [`SpecificStepIntersector<CapsuleStep>`] ([`check_specific`]).
-pub fn capsule_specific<M: FromPatches + SpecificStepIntersector<CapsuleStep>>(
-    config: &SuiteConfig,
-) {
+/// [`SpecificStepIntersector`] ([`check_specific`]).
+pub fn capsule_specific<M: FromPatches + SpecificStepIntersector>(config: &SuiteConfig) {
     run(
         config,
         "capsule_specific",
@@ -160,7 +156,7 @@ pub fn capsule_specific<M: FromPatches + SpecificStepIntersector<CapsuleStep>>(
 /// Clearance against sphere steps ([`check_clearance_vs_capsule`]).
 pub fn clearance_vs_capsule<M>(config: &SuiteConfig)
 where
-    M: FromPatches + ProximityQuery + UnspecificStepIntersector<CapsuleStep>,
+    M: FromPatches + ProximityQuery + UnspecificStepIntersector,
 {
     run(
         config,

@@ -69,7 +69,7 @@ impl<const KIND: u8> ProximityQuery for Mutant<KIND> {
     }
 }
 
-impl<const KIND: u8> UnspecificStepIntersector<CapsuleStep> for Mutant<KIND> {
+impl<const KIND: u8> UnspecificStepIntersector for Mutant<KIND> {
     fn is_step_free(&self, step: &CapsuleStep) -> bool {
         match KIND {
             IGNORES_RADIUS => self.answers.is_step_free(&step.line()),
@@ -91,7 +91,7 @@ impl<const KIND: u8> UnspecificStepIntersector<CapsuleStep> for Mutant<KIND> {
     }
 }
 
-impl<const KIND: u8> SpecificStepIntersector<CapsuleStep> for Mutant<KIND> {
+impl<const KIND: u8> SpecificStepIntersector for Mutant<KIND> {
     fn first_hit(&self, step: &CapsuleStep) -> Option<StepHit> {
         let mut hit = self.answers.first_hit(step)?;
         match KIND {

@@ -61,12 +61,12 @@ mod by_reference {
             ProximityQuery::closest_patch(&self.0, point, max_dist)
         }
     }
-    impl UnspecificStepIntersector<CapsuleStep> for Borrowed {
+    impl UnspecificStepIntersector for Borrowed {
         fn is_step_free(&self, step: &CapsuleStep) -> bool {
             patch_core::is_step_free_via_first_hit(&self.0, step)
         }
     }
-    impl SpecificStepIntersector<CapsuleStep> for Borrowed {
+    impl SpecificStepIntersector for Borrowed {
         fn first_hit(&self, step: &CapsuleStep) -> Option<StepHit> {
             SpecificStepIntersector::first_hit(&self.0, step)
         }

@@ -6,8 +6,8 @@
 //! needing them cannot be instantiated with it.
 
 use patch_core::{
-    CapsuleStep, Counted, FromPatches, LineStep, PatchMap, PatchMapMut, ProximityQuery,
-    SpecificStepIntersector, UnspecificStepIntersector,
+    Counted, FromPatches, LineStep, PatchMap, PatchMapMut, ProximityQuery, SpecificStepIntersector,
+    UnspecificStepIntersector,
 };
 use patch_map::{
     AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
@@ -19,8 +19,8 @@ fn assert_from_patches<T: FromPatches>() {}
 fn assert_proximity<T: ProximityQuery>() {}
 fn assert_line_unspecific<T: UnspecificStepIntersector<LineStep>>() {}
 fn assert_line_specific<T: SpecificStepIntersector<LineStep>>() {}
-fn assert_capsule_unspecific<T: UnspecificStepIntersector<CapsuleStep>>() {}
-fn assert_capsule_specific<T: SpecificStepIntersector<CapsuleStep>>() {}
+fn assert_capsule_unspecific<T: UnspecificStepIntersector>() {}
+fn assert_capsule_specific<T: SpecificStepIntersector>() {}
 fn assert_map_file<T: MapFile>() {}
 fn assert_memory_usage<T: MemoryUsage>() {}
 fn assert_send_sync<T: Send + Sync>() {}
@@ -33,7 +33,7 @@ where
         + FromPatches
         + ProximityQuery
         + SpecificStepIntersector<LineStep>
-        + SpecificStepIntersector<CapsuleStep>,
+        + SpecificStepIntersector,
 {
     assert_patch_map::<T>();
     assert_patch_map_mut::<T>();
@@ -121,8 +121,8 @@ macro_rules! row {
             implements!($t: ProximityQuery),
             implements!($t: UnspecificStepIntersector<LineStep>),
             implements!($t: SpecificStepIntersector<LineStep>),
-            implements!($t: UnspecificStepIntersector<CapsuleStep>),
-            implements!($t: SpecificStepIntersector<CapsuleStep>),
+            implements!($t: UnspecificStepIntersector),
+            implements!($t: SpecificStepIntersector),
             implements!($t: MapFile),
             implements!($t: MemoryUsage),
         ]

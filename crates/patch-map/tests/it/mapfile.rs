@@ -85,8 +85,8 @@ fn load_as(tag: &str, bytes: &[u8]) -> Result<(), MapFileError> {
 /// The patch maps answer every query the same way.
 fn same_answers<A, B>(a: &A, b: &B, steps: &[CapsuleStep], points: &[Point3]) -> bool
 where
-    A: ProximityQuery + SpecificStepIntersector<CapsuleStep> + SpecificStepIntersector<LineStep>,
-    B: ProximityQuery + SpecificStepIntersector<CapsuleStep> + SpecificStepIntersector<LineStep>,
+    A: ProximityQuery + SpecificStepIntersector + SpecificStepIntersector<LineStep>,
+    B: ProximityQuery + SpecificStepIntersector + SpecificStepIntersector<LineStep>,
 {
     steps.iter().all(|s| {
         a.first_hit(s) == b.first_hit(s)

@@ -42,13 +42,13 @@ fn config(space: &PlanningSpace) -> EvasionRrtConfig {
 /// only the unspecific query, does not compile; see the `EvasionRrt` docs).
 #[test]
 fn accepts_specific_intersectors() {
-    fn assert_impl<M: SpecificStepIntersector<CapsuleStep> + ?Sized>(_: &M) {}
+    fn assert_impl<M: SpecificStepIntersector + ?Sized>(_: &M) {}
     let map = BruteForceMap::new();
     let counted = Counted::new(BruteForceMap::new());
     assert_impl(&map);
     assert_impl(&counted);
     assert_impl(&&map);
-    let dynamic: &dyn SpecificStepIntersector<CapsuleStep> = &map;
+    let dynamic: &dyn SpecificStepIntersector = &map;
     let mut p = EvasionRrt::new(dynamic, space(0.5), config(&space(0.5)), 0);
     assert_eq!(p.solve(&across(0.3), &mut until_solved(5_000)), PlannerStatus::Exact);
     assert_eq!(p.name(), "evasion-rrt");

@@ -58,7 +58,7 @@ fn on_corridor_axis(q: &Point3, tolerance: Real) -> bool {
 
 #[test]
 fn accepts_maps_with_proximity_and_capsule_queries() {
-    fn takes<M: ProximityQuery + UnspecificStepIntersector<CapsuleStep> + ?Sized>(
+    fn takes<M: ProximityQuery + UnspecificStepIntersector + ?Sized>(
         map: &M,
     ) -> Vec<Box<dyn Planner + '_>> {
         let s = space(corridor_box());

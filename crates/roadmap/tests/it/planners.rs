@@ -178,9 +178,7 @@ fn counters_match_a_counted_map() {
 
 #[test]
 fn planners_accept_any_capsule_intersector() {
-    fn takes<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
-        map: &M,
-    ) -> Vec<Box<dyn Planner + '_>> {
+    fn takes<M: UnspecificStepIntersector + ?Sized>(map: &M) -> Vec<Box<dyn Planner + '_>> {
         vec![
             Box::new(Rrt::new(map, space(0.5), RrtConfig::thesis(), 0)),
             Box::new(Prm::new(map, space(0.5), PrmConfig::thesis(), 0)),
@@ -189,7 +187,7 @@ fn planners_accept_any_capsule_intersector() {
     let map = BruteForceMap::new();
     let counted = Counted::new(BruteForceMap::new());
     let by_ref = &map;
-    let dynamic: &dyn UnspecificStepIntersector<CapsuleStep> = &map;
+    let dynamic: &dyn UnspecificStepIntersector = &map;
     let problem = across(0.3);
     let mut all = takes(&map);
     all.extend(takes(&counted));

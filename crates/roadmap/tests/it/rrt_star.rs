@@ -20,9 +20,7 @@ use common::*;
 
 /// Every vertex's cost is the length of its tree path, and the tree is consistent with the
 /// roadmap's edges.
-fn assert_costs_are_path_lengths<M: UnspecificStepIntersector<CapsuleStep> + ?Sized>(
-    planner: &RrtStar<'_, M>,
-) {
+fn assert_costs_are_path_lengths<M: UnspecificStepIntersector + ?Sized>(planner: &RrtStar<'_, M>) {
     let graph = planner.roadmap();
     assert_tree(graph);
     for v in graph.node_indices() {
