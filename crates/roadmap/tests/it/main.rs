@@ -3,6 +3,7 @@
 mod common;
 mod connect;
 mod evasion;
+mod every_planner;
 mod example_data;
 mod lazy_prm;
 mod medial;
