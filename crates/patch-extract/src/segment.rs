@@ -567,9 +567,7 @@ pub fn segment_remainder(
         .collect();
     first.remainder = second.remainder.iter().map(original).collect();
     first.regions.extend(regions);
-    first
-        .regions
-        .sort_by(|a, b| b.points.len().cmp(&a.points.len()).then(a.points[0].cmp(&b.points[0])));
+    sort_largest_first(&mut first.regions);
     Ok(added)
 }
 
@@ -1470,9 +1468,14 @@ fn grow_counted(
             }
         }
     }
-    regions.sort_by(|a, b| b.points.len().cmp(&a.points.len()).then(a.points[0].cmp(&b.points[0])));
+    sort_largest_first(&mut regions);
     let remainder = (0..n as u32).filter(|&i| matches!(owner[i as usize], FREE | BENT)).collect();
     (Segmentation { regions, remainder }, taken)
+}
+
+/// Largest region first, ties by the smallest point index ([`Segmentation::regions`]' order).
+fn sort_largest_first(regions: &mut [PlanarRegion]) {
+    regions.sort_by(|a, b| b.points.len().cmp(&a.points.len()).then(a.points[0].cmp(&b.points[0])));
 }
 
 fn region_from_fit(points: Vec<u32>, fit: &PlaneFit) -> PlanarRegion {

@@ -156,6 +156,21 @@ pub fn run(args: &MapSafetyArgs, progress: &Progress) -> Result<()> {
     Ok(())
 }
 
+/// The map `load` builds from what `extract` gives, with the row's times: extraction per scan
+/// (of `scans`) and loading, seconds.
+fn timed<T>(
+    scans: usize,
+    extract: impl FnOnce() -> Result<T>,
+    load: impl FnOnce(T) -> Result<AnyMap>,
+) -> Result<(AnyMap, (Real, Real))> {
+    let started = Instant::now();
+    let extracted = extract()?;
+    let extract_seconds = started.elapsed().as_secs_f64();
+    let started = Instant::now();
+    let map = load(extracted)?;
+    Ok((map, (extract_seconds / scans.max(1) as Real, started.elapsed().as_secs_f64())))
+}
+
 /// Every row of the experiment.
 pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<SafetyRow>> {
     if args.scenes.is_empty() || args.noise.is_empty() || args.scans.is_empty() {
@@ -188,19 +203,19 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                 let spinner = progress.spinner(&format!("{name} noise {noise} scans {scans}"));
                 let clouds = scan_clouds(&scene, &setup)?;
                 for &kind in &args.maps {
-                    let started = Instant::now();
-                    let (patches, points) = match extracted_patches(&clouds, kind)? {
-                        Some(patches) => (Some(patches), Vec::new()),
-                        None => (None, pc_points(&clouds, &PcCleaning::default())?),
-                    };
-                    let extract_seconds = started.elapsed().as_secs_f64();
-                    let started = Instant::now();
-                    let map = match patches {
-                        Some(patches) => patch_map(patches, Backend::Trimesh)?,
-                        None => AnyMap::PointCloud(PointCloudMap::from_points(&points)?),
-                    };
-                    let times =
-                        (extract_seconds / scans.max(1) as Real, started.elapsed().as_secs_f64());
+                    let (map, times) = timed(
+                        scans,
+                        || {
+                            Ok(match extracted_patches(&clouds, kind)? {
+                                Some(patches) => (Some(patches), Vec::new()),
+                                None => (None, pc_points(&clouds, &PcCleaning::default())?),
+                            })
+                        },
+                        |(patches, points)| match patches {
+                            Some(patches) => patch_map(patches, Backend::Trimesh),
+                            None => Ok(AnyMap::PointCloud(PointCloudMap::from_points(&points)?)),
+                        },
+                    )?;
                     let mut row = safety_row(
                         (name, noise, scans),
                         kind.name(),
@@ -233,15 +248,11 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                         ),
                     ];
                     for (label, mixed_pixels, denoise) in cleanings {
-                        let started = Instant::now();
-                        let points = pc_points(&clouds, &PcCleaning { mixed_pixels, denoise })?;
-                        let extract_seconds = started.elapsed().as_secs_f64();
-                        let started = Instant::now();
-                        let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-                        let times = (
-                            extract_seconds / scans.max(1) as Real,
-                            started.elapsed().as_secs_f64(),
-                        );
+                        let (map, times) = timed(
+                            scans,
+                            || pc_points(&clouds, &PcCleaning { mixed_pixels, denoise }),
+                            |points| Ok(AnyMap::PointCloud(PointCloudMap::from_points(&points)?)),
+                        )?;
                         rows.push(safety_row(
                             (name, noise, scans),
                             label,
