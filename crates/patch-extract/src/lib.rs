@@ -27,6 +27,7 @@
 //! | conservative outline offset | [`offset`] | — (ours) |
 //! | holes of upward-facing patches filled, after merging | [`fill`] | — (ours) |
 //! | slabs: a back face behind each planar patch, for maps | [`slab`] | — (ours) |
+//! | free-space carving: points and veil triangles another scan saw through | [`visibility`] | — (ours) |
 //! | all of it, timed per stage | [`pipeline`] | §5.3, §6.1 |
 //!
 //! Every parameter the thesis leaves open (segmentation thresholds, α rule details, DP ε,
@@ -59,6 +60,7 @@ pub mod simplify;
 pub mod slab;
 pub mod spherical_grid;
 pub mod trimesh_grow;
+pub mod visibility;
 
 pub use merge::{MergeConfig, merge_coplanar};
 pub use mixed_pixels::{
@@ -71,3 +73,4 @@ pub use region::{PlanarRegion, Segmentation};
 pub use segment::{GrazingPlanes, SegmentConfig, segment, segment_remainder};
 pub use spherical_grid::{SphericalGrid, SphericalGridConfig};
 pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};
+pub use visibility::{FreeSpace, VisibilityConfig};

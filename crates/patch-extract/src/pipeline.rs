@@ -28,6 +28,7 @@ use crate::segment::{SegmentConfig, SegmentError, segment, segment_remainder};
 use crate::slab::{SlabError, back_faces};
 use crate::spherical_grid::{SphericalGridConfig, SphericalGridError, mesh_unorganised};
 use crate::trimesh_grow::{GrownTrimeshes, TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
+use crate::visibility::{Carved, FreeSpace, VisibilityConfig, VisibilityError};
 use patch_core::{Isometry3, Patch, PlanarPatch, Real, Vector3};
 use pointcloud::PointCloud;
 use std::time::{Duration, Instant};
@@ -81,6 +82,10 @@ pub struct PipelineConfig {
     /// of the world's +z) are filled ([`crate::fill`], not in the thesis); `None`: outlines
     /// keep their holes.
     pub fill_upward_holes: Option<Real>,
+    /// With `remainder`: the triangles of the remainder meshes that another scan saw through
+    /// are dropped ([`crate::visibility`], not in the thesis): veils across depth jumps.
+    /// `None`: every triangle stays.
+    pub carve: Option<VisibilityConfig>,
 }
 
 impl PipelineConfig {
@@ -90,7 +95,10 @@ impl PipelineConfig {
     /// merging with [`MergeConfig::alrf`], no remainder meshes, no mixed-pixel filter (on the
     /// lab it removes real obstacle points: planes map unsafe 2.8 → 3.7 %; see
     /// `patchnav experiment map-safety`), the holes of upward-facing patches filled
-    /// ([`ALRF_FILL_TILT`]), slabs [`ALRF_SLAB_THICKNESS`] thick.
+    /// ([`ALRF_FILL_TILT`]), slabs [`ALRF_SLAB_THICKNESS`] thick, and, when remainders are
+    /// meshed, their triangles that another scan saw through dropped
+    /// ([`VisibilityConfig::alrf`]; on the held-out lab the hybrid map's overcautious rate
+    /// goes 1.96 → 1.92 % with the same unsafe steps).
     pub fn alrf() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::alrf(),
@@ -103,6 +111,7 @@ impl PipelineConfig {
             denoise: Some(BeamDenoiseConfig::alrf()),
             slab_thickness: Some(ALRF_SLAB_THICKNESS),
             fill_upward_holes: Some(ALRF_FILL_TILT),
+            carve: Some(VisibilityConfig::alrf()),
         }
     }
 
@@ -118,6 +127,7 @@ impl PipelineConfig {
             denoise: None,
             slab_thickness: None,
             fill_upward_holes: None,
+            carve: None,
             ..PipelineConfig::alrf()
         }
     }
@@ -136,6 +146,7 @@ impl PipelineConfig {
             denoise: None,
             slab_thickness: None,
             fill_upward_holes: None,
+            carve: None,
         }
     }
 
@@ -153,6 +164,7 @@ impl PipelineConfig {
             denoise: None,
             slab_thickness: None,
             fill_upward_holes: None,
+            carve: None,
         }
     }
 
@@ -170,6 +182,7 @@ impl PipelineConfig {
             denoise: None,
             slab_thickness: None,
             fill_upward_holes: None,
+            carve: None,
         }
     }
 
@@ -233,6 +246,9 @@ pub enum ExtractError {
         /// The reason.
         source: MixedPixelError,
     },
+    /// Free-space carving refused its parameters or a scan.
+    #[error(transparent)]
+    Carve(#[from] VisibilityError),
     /// A scan's pose is not finite.
     #[error("scan {scan}: the sensor pose is not finite")]
     BadPose {
@@ -276,6 +292,9 @@ pub struct ScanReport {
     pub splats: usize,
     /// Outline vertices before and after simplification, summed over the regions.
     pub outline_vertices: (usize, usize),
+    /// Remainder-mesh triangles tested and dropped by free-space carving
+    /// ([`PipelineConfig::carve`]).
+    pub carved: Carved,
 }
 
 /// Wall time per stage, summed over the scans.
@@ -291,12 +310,19 @@ pub struct StageTimes {
     pub trimesh: Duration,
     /// Outline merging across scans.
     pub merging: Duration,
+    /// Free-space carving: indexing every scan's beams, testing the remainder meshes.
+    pub carving: Duration,
 }
 
 impl StageTimes {
     /// The sum of the stages.
     pub fn total(&self) -> Duration {
-        self.mixed_pixels + self.segmentation + self.polygonization + self.trimesh + self.merging
+        self.mixed_pixels
+            + self.segmentation
+            + self.polygonization
+            + self.trimesh
+            + self.merging
+            + self.carving
     }
 }
 
@@ -340,6 +366,15 @@ pub fn extract(
     mut progress: impl FnMut(usize),
 ) -> Result<Extraction, ExtractError> {
     let mut out = Extraction::default();
+    let free_space = match (&config.carve, &config.remainder) {
+        (Some(carve), Some(_)) => {
+            let t = Instant::now();
+            let space = FreeSpace::new(scans, carve)?;
+            out.times.carving += t.elapsed();
+            Some(space)
+        }
+        _ => None,
+    };
     let mut planar: Vec<PlanarPatch> = Vec::new();
     let mut meshes: Vec<Patch> = Vec::new();
     for (index, scan) in scans.iter().enumerate() {
@@ -434,14 +469,21 @@ pub fn extract(
                 (None, None) => GrownTrimeshes::default(),
             };
             report.trimesh_patches = grown.meshes.len();
-            meshes.extend(
-                grown
-                    .into_patches()
-                    .into_iter()
-                    .chain(scattered)
-                    .map(|m| Patch::Trimesh(m.transformed(&motion))),
-            );
+            let grown = grown.into_patches().into_iter().chain(scattered);
+            let grown = grown.map(|m| m.transformed(&motion));
             out.times.trimesh += t.elapsed();
+            match &free_space {
+                Some(space) => {
+                    let t = Instant::now();
+                    for mesh in grown {
+                        let (kept, carved) = space.carve_trimesh(&mesh, Some(index));
+                        report.carved += carved;
+                        meshes.extend(kept.map(Patch::Trimesh));
+                    }
+                    out.times.carving += t.elapsed();
+                }
+                None => meshes.extend(grown.map(Patch::Trimesh)),
+            }
         }
         out.scans.push(report);
         progress(index);

@@ -104,6 +104,11 @@ pub struct ExtractArgs {
     /// smaller seed windows and regions (on in the `alrf` preset; off in the others).
     #[arg(long)]
     pub no_second_pass: bool,
+    /// With --hybrid: keep every remainder triangle, also those another scan saw through
+    /// (free-space carving, `patch_extract::visibility`: on in the `alrf` preset, off in the
+    /// others).
+    #[arg(long)]
+    pub no_carve: bool,
     /// Each planar patch gets a back face this many metres behind the side it was seen from,
     /// so that the map holds slabs (0: bare surfaces; default: the sensor preset's, 0.04 m
     /// for `alrf`, none for the others). The mesh export and the plane polygons hold the
@@ -137,6 +142,9 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
     }
     if args.no_second_pass {
         config.second_pass = None;
+    }
+    if args.no_carve {
+        config.carve = None;
     }
     if let Some(t) = args.slab_thickness {
         config.slab_thickness = (t != 0.0).then_some(t);
@@ -487,6 +495,7 @@ mod tests {
             hybrid: false,
             no_merge: false,
             no_second_pass: false,
+            no_carve: false,
             slab_thickness: None,
             poses: None,
             export: None,

@@ -24,6 +24,7 @@ use crate::scene_map::{
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use patch_core::{Patch, PatchId, Point3};
+use patch_extract::VisibilityConfig;
 use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
@@ -117,6 +118,27 @@ pub struct BuildArgs {
     /// docs/map-safety.md). Off by default: the raw pc map is the occlusion floor.
     #[arg(long)]
     pub denoise: bool,
+    /// With --scene: free-space carving of the pc map's points and of the trimesh map's
+    /// triangles: what another scan saw through is dropped (`patch_extract::visibility`). Off
+    /// by default: the raw pc map is the occlusion floor, and in the trimesh map veils guard
+    /// surfaces no scan saw (see docs/map-safety.md).
+    #[arg(long, conflicts_with = "no_carve")]
+    pub carve: bool,
+    /// With --scene --source scans: keep the hybrid map's remainder triangles that another
+    /// scan saw through (the `alrf` preset drops them).
+    #[arg(long)]
+    pub no_carve: bool,
+    /// Free-space carving: radius of the ball around a point that another scan must have
+    /// seen empty, metres.
+    #[arg(long, default_value_t = VisibilityConfig::alrf().ball_radius)]
+    pub carve_ball: f64,
+    /// Free-space carving: the beams that saw the ball empty must pass within this many
+    /// metres of the point on every side.
+    #[arg(long, default_value_t = VisibilityConfig::alrf().max_gap)]
+    pub carve_gap: f64,
+    /// Free-space carving: a return within this many metres of the ball hit it (range noise).
+    #[arg(long, default_value_t = VisibilityConfig::alrf().return_margin)]
+    pub carve_margin: f64,
     /// The backend of the new map.
     #[arg(long, value_parser = names::all::<Backend>())]
     pub backend: Backend,
@@ -287,6 +309,14 @@ fn scene_source(
         .map(|f| f.validate().map(|()| f))
         .transpose()
         .context("--mixed-pixels")?;
+    let carving = VisibilityConfig {
+        ball_radius: args.carve_ball,
+        max_gap: args.carve_gap,
+        return_margin: args.carve_margin,
+        ..VisibilityConfig::alrf()
+    };
+    carving.validate().context("--carve-ball, --carve-gap, --carve-margin")?;
+    let carve = args.carve.then_some(carving);
     let patches = match (kind, args.source) {
         (MapKind::Pc, _) => None,
         (_, MapSource::Scene) => {
@@ -295,8 +325,13 @@ fn scene_source(
         }
         (_, MapSource::Scans) => {
             let clouds = scan_clouds(&scene, &setup)?;
-            let pipeline = PipelineConfig { mixed_pixels: filter, ..PipelineConfig::alrf() };
-            extracted_patches_with(&clouds, kind, pipeline, TrimeshGrowConfig::alrf())
+            let remainder_carve = (!args.no_carve).then_some(carving);
+            let pipeline = PipelineConfig {
+                mixed_pixels: filter,
+                carve: remainder_carve,
+                ..PipelineConfig::alrf()
+            };
+            extracted_patches_with(&clouds, kind, pipeline, TrimeshGrowConfig::alrf(), carve)
                 .with_context(|| format!("extracting the {kind} map from {} scans", args.scans))?
         }
     };
@@ -314,6 +349,7 @@ fn scene_source(
             let cleaning = PcCleaning {
                 mixed_pixels: filter.map(|f| (f, args.mixed_pixel_fix)),
                 denoise: args.denoise.then(BeamDenoiseConfig::alrf),
+                carve,
             };
             let points = pc_points(&scan_clouds(&scene, &setup)?, &cleaning)?;
             progress.say(format!(

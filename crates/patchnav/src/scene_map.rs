@@ -25,8 +25,8 @@ use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Rea
 use patch_extract::denoise::{BeamDenoiseConfig, denoise_along_beams};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
 use patch_extract::{
-    MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig, extract, fix_mixed_pixels,
-    grow_trimeshes,
+    FreeSpace, MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig,
+    VisibilityConfig, extract, fix_mixed_pixels, grow_trimeshes,
 };
 use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, Backend, PointCloudMap, PolygonMap};
@@ -301,6 +301,9 @@ pub struct PcCleaning {
     pub mixed_pixels: Option<(MixedPixelConfig, MixedPixelFix)>,
     /// Then move locally planar points along their beams onto their neighbourhood's plane.
     pub denoise: Option<BeamDenoiseConfig>,
+    /// Last, drop the points another scan saw through ([`FreeSpace`]), every scan's cleaned
+    /// points standing for its beams.
+    pub carve: Option<VisibilityConfig>,
 }
 
 /// The points of a pc map made from `clouds` (sensor frame with poses), each organised cloud
@@ -310,23 +313,27 @@ pub struct PcCleaning {
 /// # Errors
 /// The filter or the denoising refusing its parameters.
 pub fn pc_points(clouds: &[PointCloud], cleaning: &PcCleaning) -> Result<Vec<Point3>> {
-    let mut out = Vec::new();
+    let mut cleaned = Vec::with_capacity(clouds.len());
     for cloud in clouds {
         if cloud.grid().is_none() {
-            out.extend_from_slice(cloud.to_world().positions());
+            cleaned.push(cloud.clone());
             continue;
         }
-        let filtered = match &cleaning.mixed_pixels {
-            Some((config, fix)) => Some(fix_mixed_pixels(cloud, config, *fix)?.0),
-            None => None,
+        let mut cloud = match &cleaning.mixed_pixels {
+            Some((config, fix)) => fix_mixed_pixels(cloud, config, *fix)?.0,
+            None => cloud.clone(),
         };
-        let cloud = filtered.as_ref().unwrap_or(cloud);
-        match &cleaning.denoise {
-            Some(d) => {
-                out.extend_from_slice(denoise_along_beams(cloud, d)?.0.to_world().positions())
-            }
-            None => out.extend_from_slice(cloud.to_world().positions()),
+        if let Some(d) = &cleaning.denoise {
+            cloud = denoise_along_beams(&cloud, d)?.0;
         }
+        cleaned.push(cloud);
+    }
+    if let Some(config) = &cleaning.carve {
+        cleaned = FreeSpace::new(&cleaned, config)?.carve_clouds(&cleaned)?.0;
+    }
+    let mut out = Vec::new();
+    for cloud in &cleaned {
+        out.extend_from_slice(cloud.to_world().positions());
     }
     Ok(out)
 }
@@ -439,16 +446,19 @@ pub enum MapSource {
 /// The patches of map type `kind` extracted from `clouds` (see [`MapSource::Scans`]); `None`
 /// for the pc map.
 pub fn extracted_patches(clouds: &[PointCloud], kind: MapKind) -> Result<Option<Vec<Patch>>> {
-    extracted_patches_with(clouds, kind, PipelineConfig::alrf(), TrimeshGrowConfig::alrf())
+    extracted_patches_with(clouds, kind, PipelineConfig::alrf(), TrimeshGrowConfig::alrf(), None)
 }
 
 /// [`extracted_patches`] with the extraction thresholds `pipeline` and the trimesh growing
-/// `grow` of another sensor preset (`patchnav extract --sensor`).
+/// `grow` of another sensor preset (`patchnav extract --sensor`); the trimesh map's triangles
+/// that another scan saw through are dropped as `trimesh_carve` says (`None`: all kept; the
+/// hybrid map's remainder meshes follow [`PipelineConfig::carve`]).
 pub fn extracted_patches_with(
     clouds: &[PointCloud],
     kind: MapKind,
     pipeline: PipelineConfig,
     grow: TrimeshGrowConfig,
+    trimesh_carve: Option<VisibilityConfig>,
 ) -> Result<Option<Vec<Patch>>> {
     Ok(match kind {
         MapKind::Planes => Some(extract(clouds, &pipeline, |_| {})?.into_map_patches()),
@@ -456,8 +466,12 @@ pub fn extracted_patches_with(
             Some(extract(clouds, &pipeline.with_remainder(grow), |_| {})?.into_map_patches())
         }
         MapKind::Trimesh => {
+            let space = match &trimesh_carve {
+                Some(config) => Some(FreeSpace::new(clouds, config)?),
+                None => None,
+            };
             let mut patches = Vec::new();
-            for cloud in clouds {
+            for (index, cloud) in clouds.iter().enumerate() {
                 let motion = cloud
                     .sensor_pose()
                     .map_or_else(Isometry3::identity, |pose| pose.world_from_sensor);
@@ -470,12 +484,14 @@ pub fn extracted_patches_with(
                     _ => cloud,
                 };
                 let grown = grow_trimeshes(cloud, &grow)?;
-                patches.extend(
-                    grown
-                        .into_patches()
-                        .into_iter()
-                        .map(|m| Patch::Trimesh(m.transformed(&motion))),
-                );
+                for mesh in grown.into_patches() {
+                    let mesh = mesh.transformed(&motion);
+                    match &space {
+                        Some(space) => patches
+                            .extend(space.carve_trimesh(&mesh, Some(index)).0.map(Patch::from)),
+                        None => patches.push(Patch::Trimesh(mesh)),
+                    }
+                }
             }
             Some(patches)
         }

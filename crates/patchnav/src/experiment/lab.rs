@@ -222,6 +222,7 @@ fn build_lab(args: &LabMapArgs, progress: &Progress) -> Result<Lab> {
         let pc = PcCleaning {
             mixed_pixels: args.pc_mixed_pixels.map(|fix| (MixedPixelConfig::alrf(), fix)),
             denoise: args.pc_denoise.then(BeamDenoiseConfig::alrf),
+            carve: None,
         };
         let map = build_map(&scene, &surfaces, kind, args.backend, &t, &scans, args.source, &pc)
             .with_context(|| format!("building the {kind} map"))?;

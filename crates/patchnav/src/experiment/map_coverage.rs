@@ -191,7 +191,7 @@ pub fn cloud_coverage(
         hybrid_triangles: 0,
     };
     for kind in [MapKind::Planes, MapKind::Hybrid] {
-        let patches = extracted_patches_with(clouds, kind, pipeline.clone(), grow)?
+        let patches = extracted_patches_with(clouds, kind, pipeline.clone(), grow, None)?
             .context("patch maps have patches")?;
         if kind == MapKind::Hybrid {
             let meshes: Vec<_> = patches.iter().filter_map(Patch::as_trimesh).collect();

@@ -24,7 +24,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
 use patch_extract::denoise::BeamDenoiseConfig;
-use patch_extract::{MixedPixelConfig, MixedPixelFix};
+use patch_extract::{MixedPixelConfig, MixedPixelFix, VisibilityConfig};
 use patch_map::{
     AnyMap, Attribution, Backend, MapComparison, PointCloudMap, StepSampling, compare_maps,
 };
@@ -238,19 +238,24 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     // The pc map cleaned in three ways, and the one a perfect mixed-pixel
                     // filter would give (the simulator's phantoms dropped).
                     let filter = MixedPixelConfig::alrf();
+                    let denoise = Some(BeamDenoiseConfig::alrf());
+                    let carve = Some(VisibilityConfig::alrf());
                     let cleanings = [
-                        ("pc-removed", Some((filter, MixedPixelFix::Remove)), None),
-                        ("pc-snapped", Some((filter, MixedPixelFix::SnapToForeground)), None),
+                        ("pc-removed", Some((filter, MixedPixelFix::Remove)), None, None),
+                        ("pc-snapped", Some((filter, MixedPixelFix::SnapToForeground)), None, None),
                         (
                             "pc-snapped-denoised",
                             Some((filter, MixedPixelFix::SnapToForeground)),
-                            Some(BeamDenoiseConfig::alrf()),
+                            denoise,
+                            None,
                         ),
+                        ("pc-carved", None, None, carve),
+                        ("pc-denoised-carved", None, denoise, carve),
                     ];
-                    for (label, mixed_pixels, denoise) in cleanings {
+                    for (label, mixed_pixels, denoise, carve) in cleanings {
                         let (map, times) = timed(
                             scans,
-                            || pc_points(&clouds, &PcCleaning { mixed_pixels, denoise }),
+                            || pc_points(&clouds, &PcCleaning { mixed_pixels, denoise, carve }),
                             |points| Ok(AnyMap::PointCloud(PointCloudMap::from_points(&points)?)),
                         )?;
                         rows.push(safety_row(
@@ -263,16 +268,21 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                         )?);
                     }
                     let clean = scan_clouds_without_phantoms(&scene, &setup, PHANTOM_TOLERANCE)?;
-                    let points = pc_points(&clean, &PcCleaning::default())?;
-                    let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-                    rows.push(safety_row(
-                        (name, noise, scans),
-                        "pc-no-phantoms",
-                        &truth,
-                        &map,
-                        &sampling,
-                        (0.0, 0.0),
-                    )?);
+                    for (label, denoise) in
+                        [("pc-no-phantoms", None), ("pc-no-phantoms-denoised", denoise)]
+                    {
+                        let cleaning = PcCleaning { denoise, ..PcCleaning::default() };
+                        let points = pc_points(&clean, &cleaning)?;
+                        let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
+                        rows.push(safety_row(
+                            (name, noise, scans),
+                            label,
+                            &truth,
+                            &map,
+                            &sampling,
+                            (0.0, 0.0),
+                        )?);
+                    }
                 }
                 spinner.finish_and_clear();
             }

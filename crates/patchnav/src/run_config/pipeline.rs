@@ -60,7 +60,7 @@ enum Source {
 /// ([`crate::scene_map::extracted_patches_with`]).
 fn scan_patches(clouds: &[PointCloud], kind: MapKind, sensor: SensorPreset) -> Result<Vec<Patch>> {
     let (pipeline, grow) = sensor.configs();
-    crate::scene_map::extracted_patches_with(clouds, kind, pipeline, grow)?
+    crate::scene_map::extracted_patches_with(clouds, kind, pipeline, grow, None)?
         .context("the pc map has no patches")
 }
 
