@@ -95,10 +95,10 @@ impl PipelineConfig {
     /// merging with [`MergeConfig::alrf`], no remainder meshes, no mixed-pixel filter (on the
     /// lab it removes real obstacle points: planes map unsafe 2.8 → 3.7 %; see
     /// `patchnav experiment map-safety`), the holes of upward-facing patches filled
-    /// ([`ALRF_FILL_TILT`]), slabs [`ALRF_SLAB_THICKNESS`] thick, and, when remainders are
-    /// meshed, their triangles that another scan saw through dropped
-    /// ([`VisibilityConfig::alrf`]; on the held-out lab the hybrid map's overcautious rate
-    /// goes 1.96 → 1.92 % with the same unsafe steps).
+    /// ([`ALRF_FILL_TILT`]), slabs [`ALRF_SLAB_THICKNESS`] thick. No free-space carving of
+    /// the remainder meshes (`carve`): on the tuning seed it lets a few more colliding steps
+    /// through (docs/map-safety.md, item 12); set it to [`VisibilityConfig::alrf`] to trade
+    /// them for fewer blocked free steps.
     pub fn alrf() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::alrf(),
@@ -111,7 +111,7 @@ impl PipelineConfig {
             denoise: Some(BeamDenoiseConfig::alrf()),
             slab_thickness: Some(ALRF_SLAB_THICKNESS),
             fill_upward_holes: Some(ALRF_FILL_TILT),
-            carve: Some(VisibilityConfig::alrf()),
+            carve: None,
         }
     }
 

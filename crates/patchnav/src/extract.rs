@@ -33,6 +33,7 @@ use patch_core::triangulate::patch_triangles;
 use patch_core::{Isometry3, Patch, Point3, Real};
 use patch_extract::pipeline::{PipelineConfig, extract};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
+use patch_extract::visibility::VisibilityConfig;
 use patch_map::Backend;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
@@ -104,11 +105,10 @@ pub struct ExtractArgs {
     /// smaller seed windows and regions (on in the `alrf` preset; off in the others).
     #[arg(long)]
     pub no_second_pass: bool,
-    /// With --hybrid: keep every remainder triangle, also those another scan saw through
-    /// (free-space carving, `patch_extract::visibility`: on in the `alrf` preset, off in the
-    /// others).
-    #[arg(long)]
-    pub no_carve: bool,
+    /// With --hybrid: drop the remainder triangles another scan saw through (free-space
+    /// carving with the ALRF's thresholds, `patch_extract::visibility`; off by default).
+    #[arg(long, requires = "hybrid")]
+    pub carve: bool,
     /// Each planar patch gets a back face this many metres behind the side it was seen from,
     /// so that the map holds slabs (0: bare surfaces; default: the sensor preset's, 0.04 m
     /// for `alrf`, none for the others). The mesh export and the plane polygons hold the
@@ -143,8 +143,8 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
     if args.no_second_pass {
         config.second_pass = None;
     }
-    if args.no_carve {
-        config.carve = None;
+    if args.carve {
+        config.carve = Some(VisibilityConfig::alrf());
     }
     if let Some(t) = args.slab_thickness {
         config.slab_thickness = (t != 0.0).then_some(t);
@@ -495,7 +495,7 @@ mod tests {
             hybrid: false,
             no_merge: false,
             no_second_pass: false,
-            no_carve: false,
+            carve: false,
             slab_thickness: None,
             poses: None,
             export: None,

@@ -118,27 +118,31 @@ pub struct BuildArgs {
     /// docs/map-safety.md). Off by default: the raw pc map is the occlusion floor.
     #[arg(long)]
     pub denoise: bool,
-    /// With --scene: free-space carving of the pc map's points and of the trimesh map's
-    /// triangles: what another scan saw through is dropped (`patch_extract::visibility`). Off
-    /// by default: the raw pc map is the occlusion floor, and in the trimesh map veils guard
-    /// surfaces no scan saw (see docs/map-safety.md).
-    #[arg(long, conflicts_with = "no_carve")]
-    pub carve: bool,
-    /// With --scene --source scans: keep the hybrid map's remainder triangles that another
-    /// scan saw through (the `alrf` preset drops them).
+    /// With --scene: free-space carving: the pc map's points, the trimesh map's triangles and
+    /// the hybrid map's remainder triangles that another scan saw through are dropped
+    /// (`patch_extract::visibility`). Off by default: it opens some space no scan saw (see
+    /// docs/map-safety.md).
     #[arg(long)]
-    pub no_carve: bool,
-    /// Free-space carving: radius of the ball around a point that another scan must have
+    pub carve: bool,
+    /// With --carve: radius of the ball around a point that another scan must have
     /// seen empty, metres.
     #[arg(long, default_value_t = VisibilityConfig::alrf().ball_radius)]
     pub carve_ball: f64,
-    /// Free-space carving: the beams that saw the ball empty must pass within this many
+    /// With --carve: the beams that saw the ball empty must pass within this many
     /// metres of the point on every side.
     #[arg(long, default_value_t = VisibilityConfig::alrf().max_gap)]
     pub carve_gap: f64,
-    /// Free-space carving: a return within this many metres of the ball hit it (range noise).
+    /// With --carve: a return within this many metres of the ball hit it (range noise).
     #[arg(long, default_value_t = VisibilityConfig::alrf().return_margin)]
     pub carve_margin: f64,
+    /// With --carve: the points this many metres from a carved point along and across
+    /// its beam must have been seen by some scan (0: no such test).
+    #[arg(long, default_value_t = VisibilityConfig::alrf().neighbourhood.unwrap_or(0.0))]
+    pub carve_neighbourhood: f64,
+    /// With --carve: a triangle goes when this many of its centroid and edge midpoints
+    /// were seen empty (1–4).
+    #[arg(long, default_value_t = VisibilityConfig::alrf().min_empty_samples)]
+    pub carve_samples: usize,
     /// The backend of the new map.
     #[arg(long, value_parser = names::all::<Backend>())]
     pub backend: Backend,
@@ -313,9 +317,11 @@ fn scene_source(
         ball_radius: args.carve_ball,
         max_gap: args.carve_gap,
         return_margin: args.carve_margin,
+        neighbourhood: (args.carve_neighbourhood > 0.0).then_some(args.carve_neighbourhood),
+        min_empty_samples: args.carve_samples,
         ..VisibilityConfig::alrf()
     };
-    carving.validate().context("--carve-ball, --carve-gap, --carve-margin")?;
+    carving.validate().context("the --carve-* parameters")?;
     let carve = args.carve.then_some(carving);
     let patches = match (kind, args.source) {
         (MapKind::Pc, _) => None,
@@ -325,12 +331,7 @@ fn scene_source(
         }
         (_, MapSource::Scans) => {
             let clouds = scan_clouds(&scene, &setup)?;
-            let remainder_carve = (!args.no_carve).then_some(carving);
-            let pipeline = PipelineConfig {
-                mixed_pixels: filter,
-                carve: remainder_carve,
-                ..PipelineConfig::alrf()
-            };
+            let pipeline = PipelineConfig { mixed_pixels: filter, carve, ..PipelineConfig::alrf() };
             extracted_patches_with(&clouds, kind, pipeline, TrimeshGrowConfig::alrf(), carve)
                 .with_context(|| format!("extracting the {kind} map from {} scans", args.scans))?
         }
@@ -713,6 +714,31 @@ mod tests {
         assert!(planes <= floor + 0.15, "planes unsafe {planes:.4} vs floor {floor:.4}");
         assert!(hybrid <= floor + 0.07, "hybrid unsafe {hybrid:.4} vs floor {floor:.4}");
         assert!(planes_over <= 0.02, "planes overcautious {planes_over:.4}");
+    }
+
+    #[test]
+    fn carving_frees_space_the_pc_map_blocked_and_keeps_it_near_its_floor() {
+        let scene = scene_sim::lab(0).unwrap();
+        let truth = crate::scene_map::patch_map(
+            crate::scene_map::truth_patches(&scene).unwrap(),
+            Backend::BBox6d,
+        )
+        .unwrap();
+        let setup = ScanSetup { scans: 8, height: 0.5, step_deg: None, seed: 0, noise: 1.0 };
+        let clouds = scan_clouds(&scene, &setup).unwrap();
+        let s = StepSampling { samples: 20_000, seed: 5, ..StepSampling::in_box(truth.bounds()) };
+        let rate = |cleaning: &PcCleaning| {
+            let points = crate::scene_map::pc_points(&clouds, cleaning).unwrap();
+            let map = AnyMap::PointCloud(PointCloudMap::from_points(&points).unwrap());
+            let c = compare_maps(&truth, &map, &s, Attribution::None).unwrap();
+            (c.unsafe_rate().value, c.overcautious_rate().value)
+        };
+        let (floor, raw_over) = rate(&PcCleaning::default());
+        let carve = Some(VisibilityConfig::alrf());
+        let (carved, carved_over) = rate(&PcCleaning { carve, ..PcCleaning::default() });
+        println!("raw {floor:.4} / {raw_over:.4}, carved {carved:.4} / {carved_over:.4}");
+        assert!(carved <= floor + 0.002, "carved unsafe {carved:.4} vs floor {floor:.4}");
+        assert!(carved_over <= 0.8 * raw_over, "overcautious {carved_over:.4} vs {raw_over:.4}");
     }
 
     #[test]

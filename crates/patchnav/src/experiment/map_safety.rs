@@ -13,18 +13,27 @@
 //! edge on the truth: the share of edges that collide, and of paths to the goals that
 //! contain a colliding edge. The tuning seed of the extraction is 0; the default step and
 //! planner seeds are 1, and the scene seed is a flag.
+//!
+//! Beside the four maps: `hybrid-carved` and `trimesh-carved`, without the (remainder)
+//! triangles another scan saw through; the pc map cleaned five ways (`pc-removed`, `pc-snapped`,
+//! `pc-snapped-denoised`: mixed pixels removed or snapped; `pc-carved`,
+//! `pc-denoised-carved`: points another scan saw through dropped,
+//! [`patch_extract::visibility`]); and `pc-no-phantoms`, `pc-no-phantoms-denoised`, what a
+//! perfect mixed-pixel filter would give (the simulator's own phantoms dropped).
 
 use super::extraction::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
-    MapKind, PcCleaning, ScanSetup, extracted_patches, patch_map, pc_points, scan_clouds,
-    scan_clouds_without_phantoms, truth_patches,
+    MapKind, PcCleaning, ScanSetup, extracted_patches, extracted_patches_with, patch_map,
+    pc_points, scan_clouds, scan_clouds_without_phantoms, truth_patches,
 };
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector};
 use patch_extract::denoise::BeamDenoiseConfig;
-use patch_extract::{MixedPixelConfig, MixedPixelFix, VisibilityConfig};
+use patch_extract::{
+    MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig, VisibilityConfig,
+};
 use patch_map::{
     AnyMap, Attribution, Backend, MapComparison, PointCloudMap, StepSampling, compare_maps,
 };
@@ -233,6 +242,35 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                         row.comparison.overcautious_rate()
                     ));
                     rows.push(row);
+                }
+                // The hybrid and trimesh maps without the triangles another scan saw through.
+                for kind in [MapKind::Hybrid, MapKind::Trimesh] {
+                    if !args.maps.contains(&kind) {
+                        continue;
+                    }
+                    let carve = Some(VisibilityConfig::alrf());
+                    let (map, times) = timed(
+                        scans,
+                        || {
+                            extracted_patches_with(
+                                &clouds,
+                                kind,
+                                PipelineConfig { carve, ..PipelineConfig::alrf() },
+                                TrimeshGrowConfig::alrf(),
+                                carve,
+                            )?
+                            .context("patch maps have patches")
+                        },
+                        |patches| patch_map(patches, Backend::Trimesh),
+                    )?;
+                    rows.push(safety_row(
+                        (name, noise, scans),
+                        &format!("{kind}-carved"),
+                        &truth,
+                        &map,
+                        &sampling,
+                        times,
+                    )?);
                 }
                 if args.maps.contains(&MapKind::Pc) {
                     // The pc map cleaned in three ways, and the one a perfect mixed-pixel
