@@ -404,15 +404,39 @@ impl FreeSpace {
                 indexed: self.scans.len(),
             });
         }
+        let candidates: Vec<Vec<usize>> = scans
+            .iter()
+            .map(|scan| match (self.config.min_jump, scan.grid()) {
+                (Some(jump), Some(_)) => depth_jump_points(scan, jump),
+                _ => (0..scan.len()).collect(),
+            })
+            .collect();
+        self.carve_clouds_at(scans, &candidates)
+    }
+
+    /// [`FreeSpace::carve_clouds`] testing only the points `candidates[k]` of scan `k` (indices
+    /// at or beyond a scan's length are ignored).
+    ///
+    /// # Errors
+    /// [`VisibilityError::ScanCount`] when `scans` or `candidates` are not one per indexed
+    /// scan.
+    pub fn carve_clouds_at(
+        &self,
+        scans: &[PointCloud],
+        candidates: &[Vec<usize>],
+    ) -> Result<(Vec<PointCloud>, Carved), VisibilityError> {
+        for given in [scans.len(), candidates.len()] {
+            if given != self.scans.len() {
+                return Err(VisibilityError::ScanCount { given, indexed: self.scans.len() });
+            }
+        }
         let mut out = Vec::with_capacity(scans.len());
         let mut carved = Carved::default();
         for (index, scan) in scans.iter().enumerate() {
             let world_from_sensor =
                 scan.sensor_pose().map_or_else(Isometry3::identity, |pose| pose.world_from_sensor);
-            let candidates: Vec<usize> = match (self.config.min_jump, scan.grid()) {
-                (Some(jump), Some(_)) => depth_jump_points(scan, jump),
-                _ => (0..scan.len()).collect(),
-            };
+            let candidates: Vec<usize> =
+                candidates[index].iter().copied().filter(|&i| i < scan.len()).collect();
             let world: Vec<Point3> =
                 candidates.iter().map(|&i| world_from_sensor * scan.positions()[i]).collect();
             let flags = self.flags(&world, Some(index));
@@ -762,6 +786,11 @@ mod tests {
         assert_eq!(out[0].len(), a.len());
         assert!(out[1].len() < b.len() / 2, "{} of {}", out[1].len(), b.len());
         assert_eq!(carved.tested, a.len() + b.len());
+        // Testing no point keeps every point; one candidate list per scan is needed.
+        let (out, carved) =
+            space.carve_clouds_at(&[a.clone(), b.clone()], &[vec![], vec![]]).unwrap();
+        assert_eq!((out[1].len(), carved), (b.len(), Carved::default()));
+        assert!(space.carve_clouds_at(&[a.clone(), b.clone()], &[vec![]]).is_err());
         assert!(matches!(
             space.carve_clouds(&[a]),
             Err(VisibilityError::ScanCount { given: 1, indexed: 2 })
