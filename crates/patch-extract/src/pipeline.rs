@@ -475,11 +475,10 @@ pub fn extract(
             match &free_space {
                 Some(space) => {
                     let t = Instant::now();
-                    for mesh in grown {
-                        let (kept, carved) = space.carve_trimesh(&mesh, Some(index));
-                        report.carved += carved;
-                        meshes.extend(kept.map(Patch::Trimesh));
-                    }
+                    let grown: Vec<_> = grown.collect();
+                    let (kept, carved) = space.carve_trimeshes(&grown, Some(index));
+                    report.carved = carved;
+                    meshes.extend(kept.into_iter().map(Patch::Trimesh));
                     out.times.carving += t.elapsed();
                 }
                 None => meshes.extend(grown.map(Patch::Trimesh)),

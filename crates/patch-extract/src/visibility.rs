@@ -479,58 +479,82 @@ impl FreeSpace {
         patch: &TrimeshPatch,
         own: Option<usize>,
     ) -> (Option<TrimeshPatch>, Carved) {
-        let v = patch.vertices();
+        let (mut kept, carved) = self.carve_trimeshes(std::slice::from_ref(patch), own);
+        (kept.pop(), carved)
+    }
+
+    /// [`FreeSpace::carve_trimesh`] for many patches of one scan at once (their tests share
+    /// every core): the patches that keep a triangle, in their order.
+    pub fn carve_trimeshes(
+        &self,
+        patches: &[TrimeshPatch],
+        own: Option<usize>,
+    ) -> (Vec<TrimeshPatch>, Carved) {
         let origin = own.and_then(|i| self.scans.get(i)).map(|s| s.origin);
-        let mut tested = Vec::new();
+        // Per tested triangle: its patch and index.
+        let mut tested: Vec<(usize, usize)> = Vec::new();
         let mut samples = Vec::new();
-        for (k, t) in patch.triangles().iter().enumerate() {
-            let [a, b, c] = t.map(|i| v[i as usize]);
-            let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
-            if let (Some(max_cos), Some(o)) = (self.config.triangle_view_cos, origin) {
-                let n = (b - a).cross(&(c - a));
-                let u = centroid - o;
-                let (nn, un) = (n.norm(), u.norm());
-                if nn > 0.0 && un > 0.0 && (n.dot(&u) / (nn * un)).abs() >= max_cos {
-                    continue;
+        for (pi, patch) in patches.iter().enumerate() {
+            let v = patch.vertices();
+            for (k, t) in patch.triangles().iter().enumerate() {
+                let [a, b, c] = t.map(|i| v[i as usize]);
+                let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
+                if let (Some(max_cos), Some(o)) = (self.config.triangle_view_cos, origin) {
+                    let n = (b - a).cross(&(c - a));
+                    let u = centroid - o;
+                    let (nn, un) = (n.norm(), u.norm());
+                    if nn > 0.0 && un > 0.0 && (n.dot(&u) / (nn * un)).abs() >= max_cos {
+                        continue;
+                    }
                 }
+                tested.push((pi, k));
+                let mid = |p: Point3, q: Point3| Point3::from((p.coords + q.coords) * 0.5);
+                samples.extend([centroid, mid(a, b), mid(b, c), mid(c, a)]);
             }
-            tested.push(k);
-            let mid = |p: Point3, q: Point3| Point3::from((p.coords + q.coords) * 0.5);
-            samples.extend([centroid, mid(a, b), mid(b, c), mid(c, a)]);
         }
         let flags = self.flags(&samples, own);
-        let mut drop = vec![false; patch.num_triangles()];
-        for (&k, f) in tested.iter().zip(flags.chunks(SAMPLES_PER_TRIANGLE)) {
-            drop[k] = f.iter().filter(|&&f| f).count() >= self.config.min_empty_samples;
+        let mut drop: Vec<Vec<bool>> =
+            patches.iter().map(|p| vec![false; p.num_triangles()]).collect();
+        let mut removed = 0;
+        for (&(pi, k), f) in tested.iter().zip(flags.chunks(SAMPLES_PER_TRIANGLE)) {
+            if f.iter().filter(|&&f| f).count() >= self.config.min_empty_samples {
+                drop[pi][k] = true;
+                removed += 1;
+            }
         }
-        let removed = drop.iter().filter(|&&d| d).count();
         let carved = Carved { tested: tested.len(), removed };
-        if removed == 0 {
-            return (Some(patch.clone()), carved);
-        }
-        let kept: Vec<[u32; 3]> =
-            patch.triangles().iter().zip(&drop).filter(|&(_, &d)| !d).map(|(t, _)| *t).collect();
-        if kept.is_empty() {
-            return (None, carved);
-        }
-        // The kept triangles were valid in the patch; only the vertices they use stay.
-        let mut index = vec![u32::MAX; v.len()];
-        let mut vertices = Vec::new();
-        let triangles: Vec<[u32; 3]> = kept
-            .iter()
-            .map(|t| {
-                t.map(|i| {
-                    let slot = &mut index[i as usize];
-                    if *slot == u32::MAX {
-                        *slot = vertices.len() as u32;
-                        vertices.push(v[i as usize]);
-                    }
-                    *slot
-                })
-            })
-            .collect();
-        (TrimeshPatch::new(vertices, triangles).ok(), carved)
+        let kept = patches.iter().zip(&drop).filter_map(|(patch, drop)| without(patch, drop));
+        (kept.collect(), carved)
     }
+}
+
+/// `patch` without the triangles `drop` marks, and with only the vertices the rest use; `None`
+/// when none is left.
+fn without(patch: &TrimeshPatch, drop: &[bool]) -> Option<TrimeshPatch> {
+    if !drop.contains(&true) {
+        return Some(patch.clone());
+    }
+    let v = patch.vertices();
+    let mut index = vec![u32::MAX; v.len()];
+    let mut vertices = Vec::new();
+    let triangles: Vec<[u32; 3]> = patch
+        .triangles()
+        .iter()
+        .zip(drop)
+        .filter(|&(_, &d)| !d)
+        .map(|(t, _)| {
+            t.map(|i| {
+                let slot = &mut index[i as usize];
+                if *slot == u32::MAX {
+                    *slot = vertices.len() as u32;
+                    vertices.push(v[i as usize]);
+                }
+                *slot
+            })
+        })
+        .collect();
+    // The kept triangles were valid in the patch; an empty rest is refused (None).
+    TrimeshPatch::new(vertices, triangles).ok()
 }
 
 /// What one scan saw of the ball around a point.

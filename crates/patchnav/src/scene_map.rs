@@ -483,15 +483,16 @@ pub fn extracted_patches_with(
                     }
                     _ => cloud,
                 };
-                let grown = grow_trimeshes(cloud, &grow)?;
-                for mesh in grown.into_patches() {
-                    let mesh = mesh.transformed(&motion);
-                    match &space {
-                        Some(space) => patches
-                            .extend(space.carve_trimesh(&mesh, Some(index)).0.map(Patch::from)),
-                        None => patches.push(Patch::Trimesh(mesh)),
-                    }
-                }
+                let grown: Vec<_> = grow_trimeshes(cloud, &grow)?
+                    .into_patches()
+                    .into_iter()
+                    .map(|mesh| mesh.transformed(&motion))
+                    .collect();
+                let grown = match &space {
+                    Some(space) => space.carve_trimeshes(&grown, Some(index)).0,
+                    None => grown,
+                };
+                patches.extend(grown.into_iter().map(Patch::Trimesh));
             }
             Some(patches)
         }
