@@ -683,17 +683,27 @@ mod tests {
     /// planes 27.8 %, hybrid 19.1 % unsafe (coarse scans hold fewer points per region than the
     /// 0.5° scans of `experiment map-safety`); the bounds sit a little above and fail if the
     /// planes or hybrid map lets noticeably more collisions through.
-    #[test]
-    fn maps_from_scans_stay_near_the_occlusion_floor() {
+    /// The lab (seed 0) as exact truth, `scans` ALRF scans of it at `step_deg`, and 20,000
+    /// random steps in its box.
+    fn lab_case(
+        scans: usize,
+        step_deg: Option<f64>,
+    ) -> (AnyMap, Vec<pointcloud::PointCloud>, StepSampling) {
         let scene = scene_sim::lab(0).unwrap();
         let truth = crate::scene_map::patch_map(
             crate::scene_map::truth_patches(&scene).unwrap(),
             Backend::BBox6d,
         )
         .unwrap();
-        let setup = ScanSetup { scans: 4, height: 0.5, step_deg: Some(2.0), seed: 0, noise: 1.0 };
+        let setup = ScanSetup { scans, height: 0.5, step_deg, seed: 0, noise: 1.0 };
         let clouds = scan_clouds(&scene, &setup).unwrap();
         let s = StepSampling { samples: 20_000, seed: 5, ..StepSampling::in_box(truth.bounds()) };
+        (truth, clouds, s)
+    }
+
+    #[test]
+    fn maps_from_scans_stay_near_the_occlusion_floor() {
+        let (truth, clouds, s) = lab_case(4, Some(2.0));
         let rate = |map: &AnyMap| compare_maps(&truth, map, &s, Attribution::None).unwrap();
         let pc = AnyMap::PointCloud(
             PointCloudMap::from_points(
@@ -718,15 +728,8 @@ mod tests {
 
     #[test]
     fn carving_frees_space_the_pc_map_blocked_and_keeps_it_near_its_floor() {
-        let scene = scene_sim::lab(0).unwrap();
-        let truth = crate::scene_map::patch_map(
-            crate::scene_map::truth_patches(&scene).unwrap(),
-            Backend::BBox6d,
-        )
-        .unwrap();
-        let setup = ScanSetup { scans: 8, height: 0.5, step_deg: None, seed: 0, noise: 1.0 };
-        let clouds = scan_clouds(&scene, &setup).unwrap();
-        let s = StepSampling { samples: 20_000, seed: 5, ..StepSampling::in_box(truth.bounds()) };
+        // Full-resolution scans: at coarser steps the beams lie too far apart to carve much.
+        let (truth, clouds, s) = lab_case(8, None);
         let rate = |cleaning: &PcCleaning| {
             let points = crate::scene_map::pc_points(&clouds, cleaning).unwrap();
             let map = AnyMap::PointCloud(PointCloudMap::from_points(&points).unwrap());

@@ -273,27 +273,26 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                     )?);
                 }
                 if args.maps.contains(&MapKind::Pc) {
-                    // The pc map cleaned in three ways, and the one a perfect mixed-pixel
-                    // filter would give (the simulator's phantoms dropped).
-                    let filter = MixedPixelConfig::alrf();
+                    // The pc map cleaned five ways, and the one a perfect mixed-pixel filter
+                    // would give (the simulator's phantoms dropped), raw and denoised.
+                    let mixed = |fix| Some((MixedPixelConfig::alrf(), fix));
+                    let (remove, snap) = (MixedPixelFix::Remove, MixedPixelFix::SnapToForeground);
                     let denoise = Some(BeamDenoiseConfig::alrf());
                     let carve = Some(VisibilityConfig::alrf());
+                    let clean = scan_clouds_without_phantoms(&scene, &setup, PHANTOM_TOLERANCE)?;
                     let cleanings = [
-                        ("pc-removed", Some((filter, MixedPixelFix::Remove)), None, None),
-                        ("pc-snapped", Some((filter, MixedPixelFix::SnapToForeground)), None, None),
-                        (
-                            "pc-snapped-denoised",
-                            Some((filter, MixedPixelFix::SnapToForeground)),
-                            denoise,
-                            None,
-                        ),
-                        ("pc-carved", None, None, carve),
-                        ("pc-denoised-carved", None, denoise, carve),
+                        ("pc-removed", &clouds, mixed(remove), None, None),
+                        ("pc-snapped", &clouds, mixed(snap), None, None),
+                        ("pc-snapped-denoised", &clouds, mixed(snap), denoise, None),
+                        ("pc-carved", &clouds, None, None, carve),
+                        ("pc-denoised-carved", &clouds, None, denoise, carve),
+                        ("pc-no-phantoms", &clean, None, None, None),
+                        ("pc-no-phantoms-denoised", &clean, None, denoise, None),
                     ];
-                    for (label, mixed_pixels, denoise, carve) in cleanings {
+                    for (label, source, mixed_pixels, denoise, carve) in cleanings {
                         let (map, times) = timed(
                             scans,
-                            || pc_points(&clouds, &PcCleaning { mixed_pixels, denoise, carve }),
+                            || pc_points(source, &PcCleaning { mixed_pixels, denoise, carve }),
                             |points| Ok(AnyMap::PointCloud(PointCloudMap::from_points(&points)?)),
                         )?;
                         rows.push(safety_row(
@@ -303,22 +302,6 @@ pub fn safety_rows(args: &MapSafetyArgs, progress: &Progress) -> Result<Vec<Safe
                             &map,
                             &sampling,
                             times,
-                        )?);
-                    }
-                    let clean = scan_clouds_without_phantoms(&scene, &setup, PHANTOM_TOLERANCE)?;
-                    for (label, denoise) in
-                        [("pc-no-phantoms", None), ("pc-no-phantoms-denoised", denoise)]
-                    {
-                        let cleaning = PcCleaning { denoise, ..PcCleaning::default() };
-                        let points = pc_points(&clean, &cleaning)?;
-                        let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-                        rows.push(safety_row(
-                            (name, noise, scans),
-                            label,
-                            &truth,
-                            &map,
-                            &sampling,
-                            (0.0, 0.0),
                         )?);
                     }
                 }
