@@ -33,7 +33,7 @@ use patch_core::triangulate::patch_triangles;
 use patch_core::{Isometry3, Patch, Point3, Real};
 use patch_extract::pipeline::{PipelineConfig, extract};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
-use patch_extract::visibility::VisibilityConfig;
+use patch_extract::visibility::{Carved, VisibilityConfig};
 use patch_map::Backend;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
@@ -294,6 +294,19 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
         t.trimesh.as_secs_f64(),
         t.merging.as_secs_f64()
     )?;
+    let carved = result.scans.iter().fold(Carved::default(), |mut sum, s| {
+        sum += s.carved;
+        sum
+    });
+    if carved.tested > 0 {
+        writeln!(
+            out,
+            "free-space carving: {} of {} remainder triangles tested dropped, {:.3} s",
+            carved.removed,
+            carved.tested,
+            t.carving.as_secs_f64()
+        )?;
+    }
     let planar = result.patches.iter().filter(|p| p.as_planar().is_some()).count();
     write!(out, "patches: {planar} planar, {} trimesh", result.patches.len() - planar)?;
     if result.filled_holes > 0 {
