@@ -306,12 +306,12 @@ pub struct PcCleaning {
     pub carve: Option<VisibilityConfig>,
 }
 
-/// The points of a pc map made from `clouds` (sensor frame with poses), each organised cloud
-/// cleaned as `cleaning` says, moved to the world frame. Unorganised clouds are taken as they
-/// are.
+/// The points of a pc map made from `clouds` (sensor frame with poses), cleaned as `cleaning`
+/// says, moved to the world frame. Unorganised clouds skip the mixed-pixel fix and the
+/// denoising (both need the grid); carving tests all their points.
 ///
 /// # Errors
-/// The filter or the denoising refusing its parameters.
+/// The filter, the denoising or the carving refusing its parameters or a pose.
 pub fn pc_points(clouds: &[PointCloud], cleaning: &PcCleaning) -> Result<Vec<Point3>> {
     let mut cleaned = Vec::with_capacity(clouds.len());
     for cloud in clouds {
