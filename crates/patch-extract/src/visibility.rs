@@ -1,7 +1,7 @@
 //! Free-space carving across scans: what one scan put where another scan saw empty space goes.
 //!
 //! A beam that returns at range `r` saw the space along it up to `r` empty. A phantom, a mixed
-//! pixel in mid-air between a foreground and a background ([`crate::mixed_pixels`]), or a
+//! pixel in mid-air between a foreground and a background ([`mod@crate::mixed_pixels`]), or a
 //! "veil" triangle that trimesh growing spans across a depth jump, lies in space that the
 //! scan which made it could not see past; but a scan from another pose often looks straight
 //! through it. This module asks every *other* scan whether it saw a small ball around a point
