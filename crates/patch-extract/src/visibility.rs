@@ -388,18 +388,16 @@ impl FreeSpace {
         let seen_empty = self.scans.iter().enumerate().any(|(i, scan)| {
             Some(i) != own && scan_sees(scan, p, &self.config, angles) == Sight::Empty
         });
-        let Some(reach) = self.config.neighbourhood else { return seen_empty };
         if !seen_empty {
             return false;
         }
+        let Some(reach) = self.config.neighbourhood else { return true };
         let beam = own
             .and_then(|i| self.scans.get(i))
             .map(|scan| (p - scan.origin).normalize())
             .filter(|u| u.iter().all(|c| c.is_finite()))
             .unwrap_or_else(Vector3::z);
-        let helper = if beam.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
-        let across = beam.cross(&helper).normalize();
-        let up = beam.cross(&across);
+        let (across, up) = across(&beam);
         [beam, -beam, across, -across, up, -up].iter().all(|&offset| {
             let q = p + offset * reach;
             self.scans.iter().any(|scan| scan_sees(scan, &q, &self.config, angles) != Sight::Unseen)
@@ -416,12 +414,6 @@ impl FreeSpace {
         &self,
         scans: &[PointCloud],
     ) -> Result<(Vec<PointCloud>, Carved), VisibilityError> {
-        if scans.len() != self.scans.len() {
-            return Err(VisibilityError::ScanCount {
-                given: scans.len(),
-                indexed: self.scans.len(),
-            });
-        }
         let candidates: Vec<Vec<usize>> = scans
             .iter()
             .map(|scan| match (self.config.min_jump, scan.grid()) {
@@ -593,7 +585,7 @@ fn scan_sees(scan: &ScanBeams, p: &Point3, c: &VisibilityConfig, angles: &mut Ve
     let d = q.coords.norm();
     // The ball must lie wholly in front of the sensor, and the beams near it must be able to
     // lie within `max_gap` of it on every side.
-    if d <= c.ball_radius || d * scan.spacing > 2.0 * c.max_gap {
+    if beyond_reach(scan, d, c) {
         return Sight::Unseen;
     }
     let u = q.coords / d;
@@ -618,15 +610,13 @@ fn scan_sees_searched(
     c: &VisibilityConfig,
     angles: &mut Vec<Real>,
 ) -> Sight {
-    if d <= c.ball_radius || d * scan.spacing > 2.0 * c.max_gap {
+    if beyond_reach(scan, d, c) {
         return Sight::Unseen;
     }
     let qty = NonZeroUsize::new(c.beams).unwrap_or(NonZeroUsize::MIN);
     let found = tree.query(&[u.x, u.y, u.z]).nearest_n::<SquaredEuclidean<Real>>(qty).execute();
     // A frame on the plane across the view at p, for the angles of the evidence beams.
-    let helper = if u.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
-    let e1 = u.cross(&helper).normalize();
-    let e2 = u.cross(&e1);
+    let (e1, e2) = across(u);
     angles.clear();
     let rho2 = c.ball_radius * c.ball_radius;
     let gap2 = c.max_gap * c.max_gap;
@@ -663,6 +653,19 @@ fn scan_sees_searched(
     if widest <= c.max_gap_angle { Sight::Empty } else { Sight::Unseen }
 }
 
+/// Whether a ball at range `d` is out of `scan`'s reach: not wholly in front of the sensor,
+/// or where its beams lie too far apart to be within `max_gap` of a point on every side.
+fn beyond_reach(scan: &ScanBeams, d: Real, c: &VisibilityConfig) -> bool {
+    d <= c.ball_radius || d * scan.spacing > 2.0 * c.max_gap
+}
+
+/// Two unit vectors that span the plane across the unit vector `u`.
+fn across(u: &Vector3) -> (Vector3, Vector3) {
+    let helper = if u.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let e1 = u.cross(&helper).normalize();
+    (e1, u.cross(&e1))
+}
+
 /// The median angle between a beam and its nearest neighbour, over up to 1,000 beams spread
 /// over the scan.
 fn median_spacing(tree: &ImmutableKdTree<Real, 3>, coords: &[[Real; 3]]) -> Real {
@@ -688,7 +691,8 @@ fn median_spacing(tree: &ImmutableKdTree<Real, 3>, coords: &[[Real; 3]]) -> Real
 fn depth_jump_points(scan: &PointCloud, jump: Real) -> Vec<usize> {
     let Some(grid) = scan.grid() else { return (0..scan.len()).collect() };
     let (w, h) = (grid.width() as i64, grid.height() as i64);
-    let range = |i: usize| scan.positions()[i].coords.norm();
+    let ranges: Vec<Real> = scan.positions().iter().map(|p| p.coords.norm()).collect();
+    let range = |i: usize| ranges[i];
     let mut out = Vec::new();
     for row in 0..h {
         for col in 0..w {

@@ -32,6 +32,7 @@ use patch_map::triangulate::triangulate_polygon;
 use patch_map::{AnyMap, Backend, PointCloudMap, PolygonMap};
 use pointcloud::{BeamModel, PointCloud};
 use scene_sim::{Alrf, AlrfConfig, RangeSensor, Scene};
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::fmt;
 
@@ -313,23 +314,24 @@ pub struct PcCleaning {
 /// # Errors
 /// The filter, the denoising or the carving refusing its parameters or a pose.
 pub fn pc_points(clouds: &[PointCloud], cleaning: &PcCleaning) -> Result<Vec<Point3>> {
-    let mut cleaned = Vec::with_capacity(clouds.len());
+    // Clouds are copied only when a step changes them.
+    let mut cleaned: Vec<Cow<'_, PointCloud>> = Vec::with_capacity(clouds.len());
     for cloud in clouds {
-        if cloud.grid().is_none() {
-            cleaned.push(cloud.clone());
-            continue;
-        }
-        let mut cloud = match &cleaning.mixed_pixels {
-            Some((config, fix)) => fix_mixed_pixels(cloud, config, *fix)?.0,
-            None => cloud.clone(),
-        };
-        if let Some(d) = &cleaning.denoise {
-            cloud = denoise_along_beams(&cloud, d)?.0;
+        let mut cloud = Cow::Borrowed(cloud);
+        if cloud.grid().is_some() {
+            if let Some((config, fix)) = &cleaning.mixed_pixels {
+                cloud = Cow::Owned(fix_mixed_pixels(&cloud, config, *fix)?.0);
+            }
+            if let Some(d) = &cleaning.denoise {
+                cloud = Cow::Owned(denoise_along_beams(&cloud, d)?.0);
+            }
         }
         cleaned.push(cloud);
     }
     if let Some(config) = &cleaning.carve {
-        cleaned = FreeSpace::new(&cleaned, config)?.carve_clouds(&cleaned)?.0;
+        let clouds: Vec<PointCloud> = cleaned.into_iter().map(Cow::into_owned).collect();
+        let carved = FreeSpace::new(&clouds, config)?.carve_clouds(&clouds)?.0;
+        cleaned = carved.into_iter().map(Cow::Owned).collect();
     }
     let mut out = Vec::new();
     for cloud in &cleaned {
