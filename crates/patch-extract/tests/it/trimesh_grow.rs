@@ -193,3 +193,36 @@ fn bad_configs_are_typed_errors() {
         Err(TrimeshGrowError::Grid(GridError::MaskSize { .. }))
     ));
 }
+
+#[test]
+fn edge_on_triangles_are_not_grown_when_asked() {
+    let (cloud, _) = scene_scan();
+    let all = TrimeshGrowConfig::range_camera();
+    let min_angle = 10f64.to_radians();
+    let config = TrimeshGrowConfig { min_view_angle: Some(min_angle), ..all };
+    let grown = grow_trimeshes(&cloud, &config).unwrap();
+    let uncut = grow_trimeshes(&cloud, &all).unwrap();
+    let mut on_ball = 0;
+    for m in &grown.meshes {
+        let v = m.patch.vertices();
+        for t in m.patch.triangles() {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            let normal = (b - a).cross(&(c - a)).normalize();
+            let beam = ((a.coords + b.coords + c.coords) / 3.0).normalize();
+            assert!(normal.dot(&beam).abs() >= min_angle.sin() - 1e-12);
+        }
+        on_ball += usize::from(v.iter().all(|p| {
+            let pose = cloud.sensor_pose().unwrap().world_from_sensor;
+            sphere_distance(&(pose * p)) < 0.05
+        }));
+    }
+    assert!(on_ball > 0, "the ball still has meshes");
+    assert!(grown.stats.triangles < uncut.stats.triangles);
+    for bad in [0.0, -0.1, std::f64::consts::FRAC_PI_2, f64::NAN] {
+        let c = TrimeshGrowConfig { min_view_angle: Some(bad), ..all };
+        assert!(matches!(
+            c.validate(),
+            Err(TrimeshGrowError::BadThreshold { name: "min_view_angle", .. })
+        ));
+    }
+}
