@@ -109,7 +109,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub use pointcloud::na;
+pub use patch_math::na;
 
 pub mod capability;
 #[cfg(feature = "conformance")]
@@ -134,7 +134,7 @@ pub use patch::{
     MIN_TRIANGLE_AREA, Patch, PatchKind, PlanarPatch, Plane, PlaneCovariance, TrimeshPatch,
     plane_frame,
 };
-pub use pointcloud::{Aabb, Isometry3, Point3, Real, Vector3};
+pub use patch_math::{Aabb, Isometry3, Point3, Real, Vector3};
 pub use polygon::{Bounds2, Polygon, Ring, RingId};
 pub use reference::{BruteForceMap, StepDistance};
 pub use step::{CapsuleStep, LineStep, Step};

@@ -10,7 +10,8 @@
 //!   or actuated laser range finder) that gives every pixel its beam direction.
 //! * [`SensorPose`]: a `world_from_sensor` rigid transform.
 //! * [`PolygonMesh`]: vertices and polygonal faces (environment meshes).
-//! * [`Aabb`]: an axis-aligned box.
+//! * [`Aabb`], [`Real`], [`Point3`], [`Vector3`], [`Isometry3`]: the math types of
+//!   `patch-math`, re-exported.
 //! * [`io`]: readers and writers for PLY, PCD v0.7, OBJ, XYZ, KITTI `.bin`, 3DTK `.3d`/`.pose`
 //!   and 16-bit PNG depth images. Every reader returns a typed [`io::Error`] that names the file
 //!   position on corrupt input; none panics.
@@ -24,27 +25,17 @@
 
 pub extern crate nalgebra as na;
 
-mod aabb;
 mod cloud;
 pub mod io;
 mod mesh;
 mod pose;
 mod range_image;
 
-pub use aabb::Aabb;
 pub use cloud::{AttributeError, FieldData, Grid, INVALID_PIXEL, PointCloud, ScalarField};
 pub use mesh::{MeshError, PolygonMesh};
+pub use patch_math::{Aabb, Isometry3, Point3, Real, Vector3};
 pub use pose::SensorPose;
 pub use range_image::{
     ActuatedLrfModel, BeamModel, PinholeIntrinsics, RangeImage, RangeImageError, RangeKind,
     SphericalModel,
 };
-
-/// The one scalar type of the workspace.
-pub type Real = f64;
-/// A point in 3D.
-pub type Point3 = na::Point3<Real>;
-/// A vector in 3D.
-pub type Vector3 = na::Vector3<Real>;
-/// A rigid transform in 3D.
-pub type Isometry3 = na::Isometry3<Real>;

@@ -140,6 +140,11 @@
 //! The points, boxes and map trait of these signatures ([`Point3`], [`Aabb`], [`Real`],
 //! [`PatchMap`]) are `patch-core`'s, re-exported here. `examples/plan_on_mesh.rs` plans on an
 //! OBJ mesh in a `patch-map` backend (`cargo run -p roadmap --example plan_on_mesh`).
+//!
+//! # Features
+//! `problem-file` (off by default) adds `ProblemFile`, the planning problem file of the shared
+//! exchange format (JSON). Without it the crate reads and writes no file, and compiles no
+//! file-format crate.
 
 mod connect;
 mod evasion;
@@ -149,6 +154,7 @@ mod named;
 mod nn;
 mod planner;
 mod prm;
+#[cfg(feature = "problem-file")]
 mod problem_file;
 mod rrt;
 mod rrt_star;
@@ -169,6 +175,7 @@ pub use named::{
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
 pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
 pub use prm::{LazyPrm, Prm, PrmConfig};
+#[cfg(feature = "problem-file")]
 pub use problem_file::{MAX_ITERATIONS, ProblemFile, ProblemFileError};
 pub use rrt::{Rrt, RrtConfig, Sampler};
 pub use rrt_star::{RrtStar, RrtStarConfig};
