@@ -106,6 +106,10 @@ pub trait PatchMap {
     /// The box of all patches ([`Aabb::EMPTY`] for an empty map).
     fn bounds(&self) -> Aabb;
 
+    /// The tolerance within which this backend's answers hold (the module docs state what it
+    /// bounds); the conformance suite checks the backend against it.
+    fn tolerance(&self) -> Tolerance;
+
     /// The patch with this id, if any.
     fn patch(&self, id: PatchId) -> Option<&Patch> {
         self.patches().get(id.index())
@@ -267,6 +271,9 @@ impl<M: PatchMap + ?Sized> PatchMap for &M {
     }
     fn bounds(&self) -> Aabb {
         (**self).bounds()
+    }
+    fn tolerance(&self) -> Tolerance {
+        (**self).tolerance()
     }
     fn patch(&self, id: PatchId) -> Option<&Patch> {
         (**self).patch(id)

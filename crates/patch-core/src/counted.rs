@@ -88,6 +88,9 @@ impl<M: PatchMap> PatchMap for Counted<M> {
     fn bounds(&self) -> Aabb {
         self.inner.bounds()
     }
+    fn tolerance(&self) -> crate::Tolerance {
+        self.inner.tolerance()
+    }
     fn patch(&self, id: PatchId) -> Option<&Patch> {
         self.inner.patch(id)
     }

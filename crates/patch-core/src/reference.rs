@@ -106,6 +106,12 @@ impl PatchMap for BruteForceMap {
     fn bounds(&self) -> Aabb {
         self.bounds
     }
+
+    /// [`Tolerance::EXACT`](crate::Tolerance::EXACT): the reference's kernels are the exact
+    /// ones the others are measured against.
+    fn tolerance(&self) -> crate::Tolerance {
+        crate::Tolerance::EXACT
+    }
 }
 
 impl PatchMapMut for BruteForceMap {

@@ -140,6 +140,18 @@ impl AnyMap {
         }
     }
 
+    /// The tolerance a patch map declares ([`PatchMap::tolerance`]); `None` for a point-cloud
+    /// map, which approximates the patches by their points and has no such bound.
+    pub fn tolerance(&self) -> Option<patch_core::Tolerance> {
+        match self {
+            AnyMap::Polygon(m) => Some(m.tolerance()),
+            AnyMap::BBox6d(m) => Some(m.tolerance()),
+            AnyMap::PointCloud(_) => None,
+            AnyMap::Trimesh(m) => Some(m.tolerance()),
+            AnyMap::Rapier(m) => Some(m.tolerance()),
+        }
+    }
+
     /// The patches of a patch map, in id order; `None` for a point-cloud map.
     pub fn patches(&self) -> Option<&[Patch]> {
         match self {
@@ -222,6 +234,7 @@ mod tests {
             assert_eq!(map.backend(), backend);
             assert_eq!(map.backend_name(), backend.name());
             assert_eq!(map.patches().is_some(), backend.holds_patches(), "{backend}");
+            assert_eq!(map.tolerance().is_some(), backend.holds_patches(), "{backend}");
             let b = map.bounds();
             assert!(b.min.x <= 0.0 && b.max.x >= 1.0 && b.max.y >= 1.0, "{backend}: {b:?}");
             let mut file = Vec::new();

@@ -145,6 +145,11 @@ impl PatchMap for BBox6dMap {
     fn bounds(&self) -> Aabb {
         self.bounds
     }
+
+    /// Exact: its broad phase returns a superset of the patches the kernels report, and the narrow phase is the reference's.
+    fn tolerance(&self) -> patch_core::Tolerance {
+        patch_core::Tolerance::EXACT
+    }
 }
 
 impl PatchMapMut for BBox6dMap {

@@ -217,6 +217,11 @@ impl PatchMap for PolygonMap {
     fn bounds(&self) -> Aabb {
         self.bounds
     }
+
+    /// Exact: it runs the reference's kernels.
+    fn tolerance(&self) -> patch_core::Tolerance {
+        patch_core::Tolerance::EXACT
+    }
 }
 
 impl PatchMapMut for PolygonMap {

@@ -259,6 +259,11 @@ impl PatchMap for RapierMap {
     fn bounds(&self) -> Aabb {
         self.bounds
     }
+
+    /// [`RapierMap::TOLERANCE`]: the trimesh map's narrow phase in each collider.
+    fn tolerance(&self) -> patch_core::Tolerance {
+        Self::TOLERANCE
+    }
 }
 
 impl PatchMapMut for RapierMap {

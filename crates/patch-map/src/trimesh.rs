@@ -854,6 +854,11 @@ impl PatchMap for TrimeshMap {
     fn bounds(&self) -> Aabb {
         self.bounds
     }
+
+    /// [`TrimeshMap::TOLERANCE`]: parry's GJK decides grazing contacts to a relative precision.
+    fn tolerance(&self) -> patch_core::Tolerance {
+        Self::TOLERANCE
+    }
 }
 
 impl PatchMapMut for TrimeshMap {

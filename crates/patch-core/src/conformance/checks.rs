@@ -30,12 +30,17 @@ fn band(r: Real, tolerance: Tolerance) -> (Real, Real) {
 
 /// Checks that `map` holds exactly `patches`, in order, with consistent defaults and bounds
 /// (the map's bounds must contain every patch's and exceed their union by at most the
-/// tolerance).
+/// tolerance), and the map declares ([`PatchMap::tolerance`]) the tolerance it is checked with.
 pub fn check_map<M: PatchMap + ?Sized>(
     map: &M,
     patches: &[Patch],
     tolerance: Tolerance,
 ) -> Result<(), TestCaseError> {
+    prop_assert_eq!(
+        map.tolerance(),
+        tolerance,
+        "the map declares another tolerance than the suite checks"
+    );
     prop_assert_eq!(map.len(), patches.len(), "number of patches");
     prop_assert_eq!(map.is_empty(), patches.is_empty());
     prop_assert!(

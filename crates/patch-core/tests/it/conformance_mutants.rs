@@ -57,6 +57,9 @@ impl<const KIND: u8> PatchMap for Mutant<KIND> {
     fn bounds(&self) -> Aabb {
         self.reference.bounds()
     }
+    fn tolerance(&self) -> patch_core::Tolerance {
+        patch_core::Tolerance::EXACT
+    }
 }
 
 impl<const KIND: u8> ProximityQuery for Mutant<KIND> {

@@ -55,6 +55,9 @@ mod by_reference {
         fn bounds(&self) -> patch_core::Aabb {
             PatchMap::bounds(&self.0)
         }
+        fn tolerance(&self) -> Tolerance {
+            PatchMap::tolerance(&self.0)
+        }
     }
     impl ProximityQuery for Borrowed {
         fn closest_patch(&self, point: &Point3, max_dist: Real) -> Option<Proximity> {
