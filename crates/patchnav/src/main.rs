@@ -19,6 +19,8 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use patch_pipeline::scene_map;
+
 mod convert;
 mod demo;
 mod experiment;
@@ -31,7 +33,6 @@ mod plan;
 mod problem;
 mod progress;
 mod run_config;
-mod scene_map;
 mod simulate;
 mod terrain;
 mod tof;

@@ -64,12 +64,12 @@ pub struct BuildArgs {
     #[arg(long, requires = "kind")]
     pub scene: Option<String>,
     /// With --scene: the thesis's map type (pc needs --backend pointcloud).
-    #[arg(long, value_enum, requires = "scene")]
+    #[arg(long, value_parser = crate::names::all::<MapKind>(), requires = "scene")]
     pub kind: Option<MapKind>,
     /// With --scene: where the planes, hybrid and trimesh maps come from: the scene's exact
     /// geometry, or patch extraction from simulated ALRF scans (as the thesis built its maps;
     /// the pc map is always the scans).
-    #[arg(long, value_enum, default_value_t = MapSource::Scene, requires = "scene")]
+    #[arg(long, value_parser = crate::names::all::<MapSource>(), default_value_t = MapSource::Scene, requires = "scene")]
     pub source: MapSource,
     /// With --scene: seed of the scene, the scan poses and the sensor noise.
     #[arg(long, default_value_t = 0)]

@@ -5,6 +5,7 @@
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use patch_map::Backend;
+use patch_pipeline::{MapKind, MapSource};
 use roadmap::PlannerKind;
 use std::ffi::OsStr;
 use std::fmt;
@@ -29,6 +30,30 @@ impl Named for Backend {
 
     fn description(self) -> &'static str {
         Backend::description(self)
+    }
+}
+
+impl Named for MapKind {
+    const ALL: &'static [MapKind] = &MapKind::ALL;
+
+    fn name(self) -> &'static str {
+        MapKind::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        MapKind::description(self)
+    }
+}
+
+impl Named for MapSource {
+    const ALL: &'static [MapSource] = &MapSource::ALL;
+
+    fn name(self) -> &'static str {
+        MapSource::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        MapSource::description(self)
     }
 }
 

@@ -5,9 +5,9 @@
 //! `report.html` (one self-contained page), `results.json` and the 3D files into the output
 //! folder.
 
-pub mod model;
 pub mod pipeline;
-pub mod report;
+
+pub use patch_pipeline::{report, results as model};
 
 use crate::progress::Progress;
 use anyhow::{Context, Result};

@@ -93,13 +93,13 @@ pub struct LabMapArgs {
     pub max_patch_triangles: usize,
     /// Where the planes, hybrid and trimesh maps come from: the scene's exact geometry, or
     /// patch extraction from the simulated scans (as the thesis built its maps).
-    #[arg(long, value_enum, default_value_t = MapSource::Scans)]
+    #[arg(long, value_parser = crate::names::all::<MapSource>(), default_value_t = MapSource::Scans)]
     pub source: MapSource,
     /// Backend of the planes, hybrid and trimesh maps (the pc map is always a point-cloud map).
     #[arg(long, value_parser = crate::names::patch_backends(), default_value_t = Backend::Trimesh)]
     pub backend: Backend,
     /// The map types to run, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = MapKind::ALL)]
+    #[arg(long, value_parser = crate::names::all::<MapKind>(), value_delimiter = ',', default_values_t = MapKind::ALL)]
     pub maps: Vec<MapKind>,
     /// Robot radius (the capsule of every step), metres (not given in the thesis for the Lab).
     #[arg(long, default_value_t = 0.3)]

@@ -60,7 +60,7 @@ pub struct MapSafetyArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [8usize, 29])]
     pub scans: Vec<usize>,
     /// The map types, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = MapKind::ALL)]
+    #[arg(long, value_parser = crate::names::all::<MapKind>(), value_delimiter = ',', default_values_t = MapKind::ALL)]
     pub maps: Vec<MapKind>,
     /// Random capsule steps per map.
     #[arg(long, default_value_t = 100_000)]

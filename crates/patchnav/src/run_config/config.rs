@@ -329,11 +329,6 @@ fn named<T: Named>(key: &str, text: &str, parser: NameParser<T>) -> Result<T> {
     parser.parse(text).map_err(|e| anyhow::anyhow!("{key}: {e}"))
 }
 
-/// Every item of `texts` as a value enum, no repeats, at least one.
-fn choices<T: ValueEnum + PartialEq>(key: &str, texts: &[String]) -> Result<Vec<T>> {
-    list(key, texts, choice::<T>)
-}
-
 /// Every item of `texts` as a name `parser` accepts, no repeats, at least one.
 fn named_list<T: Named>(key: &str, texts: &[String], parser: NameParser<T>) -> Result<Vec<T>> {
     list(key, texts, |k, t| named(k, t, parser))
@@ -541,7 +536,7 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
     let allowed = allowed_types(&input);
     let types = match &m.types {
         Some(t) => {
-            let t: Vec<MapKind> = choices("maps.types", t)?;
+            let t: Vec<MapKind> = named_list("maps.types", t, names::all())?;
             if let Some(bad) = t.iter().find(|k| !allowed.contains(k)) {
                 let from = match input {
                     Input::Scans { .. } => "scans",

@@ -9,7 +9,7 @@ mod html;
 mod raster;
 mod svg;
 
-use super::model::{
+use crate::results::{
     DemoResults, MapDrawing, MapRow, PlanRun, TerrainSection, TofSection, VolumeSection,
 };
 use anyhow::Result;
@@ -885,8 +885,8 @@ fn section_files(r: &DemoResults) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::demo::model::*;
-    use crate::demo::model::{MapSafety, SafetySection};
+    use crate::results::*;
+    use crate::results::{MapSafety, SafetySection};
 
     fn plan(map: &str, planner: &str, solved: bool) -> PlanRun {
         PlanRun {

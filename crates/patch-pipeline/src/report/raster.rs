@@ -1,7 +1,7 @@
 //! Raster pictures of the report: the ToF pixel outcomes and the explored-volume slice.
 
 use super::encode::Rgb;
-use crate::demo::model::{TofSection, VolumeSection};
+use crate::results::{TofSection, VolumeSection};
 
 /// Largest picture side accepted from the data, pixels (a guard against absurd sizes).
 const MAX_SIDE: u32 = 8192;

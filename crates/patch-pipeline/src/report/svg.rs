@@ -3,7 +3,7 @@
 
 use super::html::{esc, sig};
 use super::raster::{hex, map_colour};
-use crate::demo::model::{MapDrawing, P3, PlanRun, TimingCurve};
+use crate::results::{MapDrawing, P3, PlanRun, TimingCurve};
 use roadmap::PlannerKind;
 use std::fmt::Write as _;
 

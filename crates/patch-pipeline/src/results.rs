@@ -1,5 +1,5 @@
-//! What `patchnav demo` measured: the data the pipeline ([`super::pipeline`]) produces and the
-//! report ([`super::report`]) draws. Written to `results.json` beside `report.html`, so the
+//! What `patchnav demo` and `patchnav run` measured: the data their pipeline produces and the
+//! report ([`crate::report`]) draws. Written to `results.json` beside `report.html`, so the
 //! report can be regenerated and its numbers read by other tools.
 //!
 //! Geometry is in world coordinates (metres, z up). Lists meant for pictures (points, triangles,
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 pub type P3 = [f64; 3];
 
 /// How much work the demo does.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Scale {
     /// A few seconds: 2 scans, short runs (tests and CI).
     Quick,

@@ -20,7 +20,6 @@
 //! up to `r·(1 − cos(π/n))` inside the true surface for `n` segments around.
 
 use anyhow::{Context, Result, bail};
-use clap::ValueEnum;
 use patch_core::{FromPatches, Isometry3, Patch, PlanarPatch, Point2, Point3, Real, TrimeshPatch};
 use patch_extract::denoise::{BeamDenoiseConfig, denoise_along_beams};
 use patch_extract::projection::{AlrfSideColumns, invalidate_alrf_side_columns};
@@ -35,9 +34,12 @@ use scene_sim::{Alrf, AlrfConfig, RangeSensor, Scene};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::fmt;
+use std::str::FromStr;
+
+use crate::UnknownName;
 
 /// The map types of the thesis's Table 6.1.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, ValueEnum)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum MapKind {
     /// Planar patches only.
     Planes,
@@ -61,6 +63,24 @@ impl MapKind {
             MapKind::Trimesh => "trimesh",
             MapKind::Pc => "pc",
         }
+    }
+
+    /// One line for help texts.
+    pub fn description(self) -> &'static str {
+        match self {
+            MapKind::Planes => "Planar patches only",
+            MapKind::Hybrid => "Planar patches plus the curved surfaces as trimesh patches",
+            MapKind::Trimesh => "Every surface as a fine triangle mesh",
+            MapKind::Pc => "Simulated ALRF scans as a point-cloud map",
+        }
+    }
+}
+
+impl FromStr for MapKind {
+    type Err = UnknownName;
+
+    fn from_str(name: &str) -> Result<MapKind, UnknownName> {
+        UnknownName::find("map kind", &MapKind::ALL, MapKind::name, name)
     }
 }
 
@@ -435,7 +455,7 @@ pub fn truth_patches(scene: &Scene) -> Result<Vec<Patch>> {
 }
 
 /// Where the patches of the planes, hybrid and trimesh maps come from.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum MapSource {
     /// The scene's exact geometry.
     Scene,
@@ -443,6 +463,43 @@ pub enum MapSource {
     /// planes = planar patches merged across scans, hybrid = planes + trimesh patches grown on
     /// each scan's remainder, trimesh = whole scans meshed by trimesh growing (Algorithms 4, 5).
     Scans,
+}
+
+impl MapSource {
+    /// Both, the exact scene first.
+    pub const ALL: [MapSource; 2] = [MapSource::Scene, MapSource::Scans];
+
+    /// The lower-case name (`scene`, `scans`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MapSource::Scene => "scene",
+            MapSource::Scans => "scans",
+        }
+    }
+
+    /// One line for help texts.
+    pub fn description(self) -> &'static str {
+        match self {
+            MapSource::Scene => "The scene's exact geometry",
+            MapSource::Scans => {
+                "Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1)"
+            }
+        }
+    }
+}
+
+impl fmt::Display for MapSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for MapSource {
+    type Err = UnknownName;
+
+    fn from_str(name: &str) -> Result<MapSource, UnknownName> {
+        UnknownName::find("map source", &MapSource::ALL, MapSource::name, name)
+    }
 }
 
 /// The patches of map type `kind` extracted from `clouds` (see [`MapSource::Scans`]); `None`
@@ -503,7 +560,7 @@ pub fn extracted_patches_with(
 }
 
 /// The constrained Delaunay triangulation of a planar patch, in the world.
-pub(crate) fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+pub fn planar_triangles(p: &PlanarPatch) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     let rings: Vec<Vec<[f64; 2]>> =
         p.polygon().rings().map(|r| r.points().iter().map(|q| [q.x, q.y]).collect()).collect();
     let t = triangulate_polygon(&rings)?;
