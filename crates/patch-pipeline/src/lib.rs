@@ -7,7 +7,10 @@
 //!   maps from scans are compared with.
 //! * [`results`]: what the demo and `run` measured ([`DemoResults`]), as written to
 //!   `results.json`.
+//! * [`lab`]: the thesis's §6.1 experiments on the simulated lab (Fig 6.4, Tables 6.1, 6.2,
+//!   6.4): its maps, corner starts, timed RRTs and explored volumes.
 //! * [`report`]: the self-contained HTML page drawn from those results.
+//! * [`progress`]: how long steps say how far they got ([`Progress`]; [`Silent`] says nothing).
 //!
 //! The programs (`patchnav`, `bench-matrix`) parse arguments, show progress and print; the
 //! logic they share lives here. No command-line type crosses into this crate: its enums parse
@@ -27,10 +30,13 @@
 //! # Ok::<(), patch_pipeline::UnknownName>(())
 //! ```
 
+pub mod lab;
+pub mod progress;
 pub mod report;
 pub mod results;
 pub mod scene_map;
 
+pub use progress::{Progress, Silent, Ticker};
 pub use results::DemoResults;
 pub use scene_map::{MapKind, MapSource};
 

@@ -51,3 +51,31 @@ impl Progress {
         }
     }
 }
+
+/// A bar as the library sees it.
+struct Bar(ProgressBar);
+
+impl patch_pipeline::Ticker for Bar {
+    fn inc(&self, n: u64) {
+        self.0.inc(n);
+    }
+    fn finish_and_clear(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// The library's steps report through the same bars and lines as the program's.
+impl patch_pipeline::Progress for Progress {
+    fn bar(&self, len: u64, what: &str) -> Box<dyn patch_pipeline::Ticker> {
+        Box::new(Bar(Progress::bar(self, len, what)))
+    }
+    fn spinner(&self, what: &str) -> Box<dyn patch_pipeline::Ticker> {
+        Box::new(Bar(Progress::spinner(self, what)))
+    }
+    fn say(&self, line: &str) {
+        Progress::say(self, line);
+    }
+    fn report(&self, text: &str) {
+        Progress::report(self, text);
+    }
+}

@@ -7,11 +7,11 @@
 //! RRTs fill the grid), or either alone.
 
 use crate::demo::model::{TimingCurve, VolumeSection};
-use crate::experiment::lab::{CheckpointTimer, checkpoints, explored};
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
+use patch_pipeline::lab::{CheckpointTimer, checkpoints, explored};
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
 use roadmap::volume::{CongruenceTable, VoxelGrid};

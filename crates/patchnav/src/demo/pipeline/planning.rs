@@ -4,17 +4,15 @@
 
 use super::explore::{Exploration, Target, explore};
 use super::maps::Built;
-use super::{
-    Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, SCAN_HEIGHT, STEP, Settings, decimate, p3, p3mm,
-};
+use super::{Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, STEP, Settings, decimate, p3, p3mm};
 use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
-use crate::experiment::lab::{LabMapArgs, common_box, corner_starts};
 use crate::plan::{write_obj_paths, write_obj_roadmap};
 use crate::progress::Progress;
-use crate::scene_map::{BuiltMap, MapKind, MapSource};
+use crate::scene_map::{BuiltMap, MapKind};
 use anyhow::{Context, Result, bail};
 use patch_core::Point3;
-use patch_map::{AnyMap, Backend};
+use patch_map::AnyMap;
+use patch_pipeline::lab::{common_box, corner_starts};
 use roadmap::metrics::{turn_angles, upper_quartile};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlannerStatus,
@@ -50,33 +48,10 @@ fn planner(
     })
 }
 
-/// The lab experiments' settings for what the corner search reads (radius, four corners).
-fn corner_args() -> LabMapArgs {
-    LabMapArgs {
-        scene_seed: 0,
-        scans: 0,
-        scan_step_deg: None,
-        scan_height: SCAN_HEIGHT,
-        curved_edge: 0.1,
-        mesh_edge: 0.1,
-        max_patch_triangles: 324,
-        source: MapSource::Scans,
-        backend: Backend::Trimesh,
-        maps: MapKind::ALL.to_vec(),
-        radius: RADIUS,
-        step: STEP,
-        starts: 4,
-        max_iterations: 0,
-        pc_mixed_pixels: None,
-        pc_denoise: false,
-        common_box: false,
-    }
-}
-
 /// The first point free on every map near each of the four room corners, 1 m up (the lab
 /// experiments' starts).
 pub(super) fn starts(built: &Built) -> Result<Vec<Point3>> {
-    corner_starts(&built.maps, &common_box(&built.maps), &corner_args())
+    corner_starts(&built.maps, &common_box(&built.maps), RADIUS, 4)
 }
 
 /// The demo's planning problem: from the south-west corner start to the south-east and
