@@ -7,6 +7,9 @@
 //!   maps from scans are compared with.
 //! * [`results`]: what the demo and `run` measured ([`DemoResults`]), as written to
 //!   `results.json`.
+//! * [`demo`]: the demo's stages on the lab (sensors, maps, safety, planning, explored
+//!   volume), the pieces `patchnav run` reuses on the user's data.
+//! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`lab`]: the thesis's §6.1 experiments on the simulated lab (Fig 6.4, Tables 6.1, 6.2,
 //!   6.4): its maps, corner starts, timed RRTs and explored volumes.
 //! * [`report`]: the self-contained HTML page drawn from those results.
@@ -30,7 +33,9 @@
 //! # Ok::<(), patch_pipeline::UnknownName>(())
 //! ```
 
+pub mod demo;
 pub mod lab;
+pub mod polylines;
 pub mod progress;
 pub mod report;
 pub mod results;

@@ -8,12 +8,13 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
+use patch_pipeline::polylines::{write_obj_lines, write_obj_roadmap};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlanningSpace,
     Problem, ShortcutConfig, named_planner_on, shortcut_path,
 };
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `patchnav plan`: either one run on a map file (`MAP --start --goal --radius`),
 /// or the runs of a shared planning problem (`--problem P.json --backend B --mode M`).
@@ -182,44 +183,4 @@ pub(crate) fn make_planner(
     seed: u64,
 ) -> Result<Box<dyn Planner + '_>> {
     Ok(named_planner_on(kind, map, space, seed)?)
-}
-
-/// Writes vertices and polylines as an OBJ file (`v x y z`, `l i j ...`, 1-based).
-/// Writes a roadmap as OBJ: its vertices and one two-point polyline per edge.
-pub(crate) fn write_obj_roadmap(path: &Path, graph: &roadmap::Roadmap) -> Result<()> {
-    let points: Vec<Point3> = graph.node_weights().copied().collect();
-    let lines = graph
-        .edge_indices()
-        .filter_map(|e| graph.edge_endpoints(e))
-        .map(|(a, b)| vec![a.index(), b.index()]);
-    write_obj_lines(path, &points, lines)
-}
-
-/// Writes `paths` as OBJ polylines, one per path.
-pub(crate) fn write_obj_paths(path: &Path, paths: &[Vec<Point3>]) -> Result<()> {
-    let points: Vec<Point3> = paths.iter().flatten().copied().collect();
-    let mut first = 0;
-    let lines = paths.iter().map(move |p| {
-        let line = (first..first + p.len()).collect();
-        first += p.len();
-        line
-    });
-    write_obj_lines(path, &points, lines)
-}
-
-pub(crate) fn write_obj_lines(
-    path: &Path,
-    points: &[Point3],
-    lines: impl Iterator<Item = Vec<usize>>,
-) -> Result<()> {
-    let mut text = String::new();
-    for p in points {
-        writeln!(text, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    for line in lines {
-        let ids: Vec<String> = line.iter().map(|i| (i + 1).to_string()).collect();
-        writeln!(text, "l {}", ids.join(" "))?;
-    }
-    pointcloud::io::write_bytes_atomically(path, text)?;
-    Ok(())
 }

@@ -5,9 +5,7 @@
 //! `report.html` (one self-contained page), `results.json` and the 3D files into the output
 //! folder.
 
-pub mod pipeline;
-
-pub use patch_pipeline::{report, results as model};
+pub use patch_pipeline::{demo as pipeline, report, results as model};
 
 use crate::progress::Progress;
 use anyhow::{Context, Result};

@@ -15,13 +15,13 @@
 //!   bbox6d, trimesh, rapier), the pc map in the point-cloud backend. A row's build time is
 //!   the patch extraction of that map type plus loading into the backend; its file size is
 //!   the size of the map file `patchnav map build` would write (serialised, not kept).
-//! * Planning runs on one backend per map type ([`plan_backend`]): the parry BVH (`trimesh`,
+//! * Planning runs on one backend per map type ([`maps::plan_backend`]): the parry BVH (`trimesh`,
 //!   the role of the thesis's Bullet) for the patch maps, since a trimesh map in the
 //!   backends with a per-patch narrow phase (polygon, bbox6d) is three orders of magnitude
 //!   slower to plan on; the pc map in the point-cloud backend (Algorithm 10).
 //! * Robot radius 0.3 m, RRT step 1.0 m, each map sampled in its own box (as the lab
 //!   experiments). Starts and goals: the free points near the four room corners
-//!   ([`crate::experiment::lab`]); plans go from the first corner to the other three (goal
+//!   ([`crate::lab`]); plans go from the first corner to the other three (goal
 //!   tolerance 0.5 m) and stop when all are reached or the budget is spent. The planners are
 //!   thesis Algorithm 13 with a 5 % goal bias and Algorithm 14 (six neighbours), without the
 //!   §6.2.3 direct goal test: the corners see each other at 1 m height, so that test alone
@@ -31,14 +31,14 @@
 //!   a goal only by a sample within the tolerance, often misses: such runs are reported
 //!   unsolved, with the paths to the goals they reached.
 
-pub(crate) mod explore;
-pub(crate) mod maps;
-pub(crate) mod planning;
-pub(crate) mod safety;
-pub(crate) mod sensors;
+pub mod explore;
+pub mod maps;
+pub mod planning;
+pub mod safety;
+pub mod sensors;
 
-use super::model::{DemoResults, FileEntry, Scale, SceneInfo, StageTime};
-use crate::progress::Progress;
+use crate::Progress;
+use crate::results::{DemoResults, FileEntry, Scale, SceneInfo, StageTime};
 use anyhow::{Context, Result, bail};
 use patch_core::Point3;
 use std::path::{Path, PathBuf};
@@ -125,24 +125,25 @@ impl Settings {
 }
 
 /// The files written so far, with their sizes.
-pub(crate) struct Files {
+pub struct Files {
     out: PathBuf,
-    pub(crate) entries: Vec<FileEntry>,
+    /// Each file, in the order written.
+    pub entries: Vec<FileEntry>,
 }
 
 impl Files {
     /// No files yet, in the folder `out`.
-    pub(crate) fn new(out: &Path) -> Files {
+    pub fn new(out: &Path) -> Files {
         Files { out: out.to_owned(), entries: Vec::new() }
     }
 
     /// The path of `name` in the output folder.
-    pub(crate) fn path(&self, name: &str) -> PathBuf {
+    pub fn path(&self, name: &str) -> PathBuf {
         self.out.join(name)
     }
 
     /// Records the file `name` (already written) as `label`.
-    pub(crate) fn add(&mut self, label: impl Into<String>, name: &str) -> Result<()> {
+    pub fn add(&mut self, label: impl Into<String>, name: &str) -> Result<()> {
         let path = self.path(name);
         let bytes =
             std::fs::metadata(&path).with_context(|| format!("reading {}", path.display()))?.len();
@@ -152,19 +153,26 @@ impl Files {
 }
 
 /// Wall time of each stage.
-pub(crate) struct Clock {
-    pub(crate) stages: Vec<StageTime>,
+pub struct Clock {
+    /// Each stage's time, in order.
+    pub stages: Vec<StageTime>,
     t0: Instant,
+}
+
+impl Default for Clock {
+    fn default() -> Clock {
+        Clock::new()
+    }
 }
 
 impl Clock {
     /// Starts the first stage.
-    pub(crate) fn new() -> Clock {
+    pub fn new() -> Clock {
         Clock { stages: Vec::new(), t0: Instant::now() }
     }
 
     /// Ends the current stage as `stage`.
-    pub(crate) fn lap(&mut self, stage: &str) {
+    pub fn lap(&mut self, stage: &str) {
         self.stages
             .push(StageTime { stage: stage.to_owned(), seconds: self.t0.elapsed().as_secs_f64() });
         self.t0 = Instant::now();
@@ -172,19 +180,19 @@ impl Clock {
 }
 
 /// `p` as an array.
-pub(crate) fn p3(p: &Point3) -> [f64; 3] {
+pub fn p3(p: &Point3) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
 /// `p` rounded to millimetres, for the drawing lists (shorter JSON; the 3D files keep full
 /// precision).
-pub(crate) fn p3mm(p: &Point3) -> [f64; 3] {
+pub fn p3mm(p: &Point3) -> [f64; 3] {
     [p.x, p.y, p.z].map(|c| (c * 1000.0).round() / 1000.0)
 }
 
 /// Writes `cloud` as binary PLY with 32-bit float positions (a quarter of a millimetre at
 /// 1 km; half the size of doubles).
-pub(crate) fn write_ply_f32(path: &Path, cloud: &pointcloud::PointCloud) -> Result<()> {
+pub fn write_ply_f32(path: &Path, cloud: &pointcloud::PointCloud) -> Result<()> {
     let options = pointcloud::io::ply::PlyWriteOptions::default();
     pointcloud::io::write_atomically(path, |w| {
         pointcloud::io::ply::write_ply(w, cloud, &options)
@@ -194,11 +202,7 @@ pub(crate) fn write_ply_f32(path: &Path, cloud: &pointcloud::PointCloud) -> Resu
 
 /// Writes a triangle mesh as binary little-endian PLY with 32-bit float vertices (what viewers
 /// read; half the size of doubles).
-pub(crate) fn write_mesh_f32(
-    path: &Path,
-    vertices: &[Point3],
-    triangles: &[[u32; 3]],
-) -> Result<()> {
+pub fn write_mesh_f32(path: &Path, vertices: &[Point3], triangles: &[[u32; 3]]) -> Result<()> {
     pointcloud::io::write_atomically(path, |w| -> std::io::Result<()> {
         write!(
             w,
@@ -225,7 +229,7 @@ pub(crate) fn write_mesh_f32(
 }
 
 /// At most `max` of `items`, evenly spread (every ⌈n / max⌉-th).
-pub(crate) fn decimate<T: Clone>(items: &[T], max: usize) -> Vec<T> {
+pub fn decimate<T: Clone>(items: &[T], max: usize) -> Vec<T> {
     let stride = items.len().div_ceil(max.max(1)).max(1);
     items.iter().step_by(stride).cloned().collect()
 }
@@ -235,7 +239,7 @@ pub(crate) fn decimate<T: Clone>(items: &[T], max: usize) -> Vec<T> {
 /// # Errors
 /// A stage failing (a scene, sensor, extraction, backend or planner refusing its input), no
 /// free start near a corner, or a file that cannot be written.
-pub fn run(scale: Scale, seed: u64, out: &Path, progress: &Progress) -> Result<DemoResults> {
+pub fn run(scale: Scale, seed: u64, out: &Path, progress: &dyn Progress) -> Result<DemoResults> {
     let settings = Settings::of(scale);
     if !out.is_dir() {
         bail!("{} is not a folder", out.display());

@@ -6,12 +6,12 @@
 //! One call does both from the same runs when both are asked for (the demo's way: the timed
 //! RRTs fill the grid), or either alone.
 
-use crate::demo::model::{TimingCurve, VolumeSection};
-use crate::progress::Progress;
+use crate::Progress;
+use crate::lab::{CheckpointTimer, checkpoints, explored};
+use crate::results::{TimingCurve, VolumeSection};
 use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};
 use patch_map::AnyMap;
-use patch_pipeline::lab::{CheckpointTimer, checkpoints, explored};
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
 use roadmap::volume::{CongruenceTable, VoxelGrid};
@@ -44,32 +44,32 @@ fn explorer<'m>(
 }
 
 /// One map to explore, with its name in the results (the map type, or type and backend).
-pub(crate) struct Target<'a> {
+pub struct Target<'a> {
     /// Name in the timing curves and the volume table.
-    pub(crate) name: String,
+    pub name: String,
     /// The map.
-    pub(crate) map: &'a AnyMap,
+    pub map: &'a AnyMap,
 }
 
 /// What to grow on every map: one run per start and seed, each to `iterations`.
-pub(crate) struct Exploration<'a> {
+pub struct Exploration<'a> {
     /// The planner, one of [`EXPLORE_PLANNERS`].
-    pub(crate) planner: PlannerKind,
+    pub planner: PlannerKind,
     /// Iterations of every run (K).
-    pub(crate) iterations: u64,
+    pub iterations: u64,
     /// Starts; the slice lies at the first one's height.
-    pub(crate) starts: &'a [Point3],
+    pub starts: &'a [Point3],
     /// Seeds, each run from every start.
-    pub(crate) seeds: &'a [u64],
+    pub seeds: &'a [u64],
     /// Robot radius, metres.
-    pub(crate) radius: Real,
+    pub radius: Real,
     /// Longest RRT edge, metres.
-    pub(crate) step: Real,
+    pub step: Real,
     /// `Some(n)`: time every run at about `n` checkpoints ([`checkpoints`]) for the Fig 6.4
     /// curves.
-    pub(crate) checkpoints: Option<u64>,
+    pub checkpoints: Option<u64>,
     /// `Some(n)`: rasterise every run's explored space into `n`³ voxels covering all maps.
-    pub(crate) cells: Option<u32>,
+    pub cells: Option<u32>,
 }
 
 /// Grows `e.planner` from every start with every seed on every target, each map sampled in
@@ -81,10 +81,10 @@ pub(crate) struct Exploration<'a> {
 /// No target, start or seed; a start not free on a map; a run that stopped before its last
 /// checkpoint; a bad grid (see [`VoxelGrid::covering`]); more than [`MAX_VOLUME_MAPS`] maps
 /// with a grid.
-pub(crate) fn explore(
+pub fn explore(
     targets: &[Target<'_>],
     e: &Exploration<'_>,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> Result<(Vec<TimingCurve>, Option<VolumeSection>)> {
     if targets.is_empty() || e.starts.is_empty() || e.seeds.is_empty() || e.iterations == 0 {
         bail!("an exploration needs maps, starts, seeds and iterations");

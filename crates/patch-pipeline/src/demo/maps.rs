@@ -5,8 +5,8 @@
 use super::{
     Files, MAX_DRAWN, SCAN_HEIGHT, Settings, decimate, p3mm, write_mesh_f32, write_ply_f32,
 };
-use crate::demo::model::{MapDrawing, MapRow, P3};
-use crate::progress::Progress;
+use crate::Progress;
+use crate::results::{MapDrawing, MapRow, P3};
 use crate::scene_map::{
     BuiltMap, MapKind, ScanSetup, extracted_patches, patch_map, planar_triangles, scan_clouds,
 };
@@ -21,24 +21,24 @@ use std::time::Instant;
 /// The backend each patch map type is planned on: the parry BVH (the role of the thesis's
 /// Bullet maps). A trimesh map in `polygon` or `bbox6d` pays for every triangle of each
 /// candidate patch (about 1.5 s per 300 RRT iterations on two scans' map, against 5 ms).
-pub(crate) fn plan_backend(_kind: MapKind) -> Backend {
+pub fn plan_backend(_kind: MapKind) -> Backend {
     Backend::Trimesh
 }
 
 /// The scanned lab.
-pub(crate) struct Lab {
+pub struct Lab {
     /// The scene.
-    pub(crate) scene: Scene,
+    pub scene: Scene,
     /// Organised scans in the sensor frame with their poses (the ±90° columns dropped).
-    pub(crate) clouds: Vec<PointCloud>,
+    pub clouds: Vec<PointCloud>,
     /// Scanner positions.
-    pub(crate) positions: Vec<Point3>,
+    pub positions: Vec<Point3>,
     /// Points of all scans.
-    pub(crate) points: usize,
+    pub points: usize,
 }
 
 /// Simulates the lab's ALRF scans and writes each (`scan-N.ply`, sensor frame with its pose).
-pub(super) fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Result<Lab> {
+pub fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Result<Lab> {
     let scene = scene_sim::lab(seed).context("building the lab scene")?;
     let setup =
         ScanSetup { scans: settings.scans, height: SCAN_HEIGHT, step_deg: None, seed, noise: 1.0 };
@@ -57,18 +57,18 @@ pub(super) fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Res
 }
 
 /// Everything built from the scans.
-pub(crate) struct Built {
+pub struct Built {
     /// One map per type, in the planning backend.
-    pub(crate) maps: Vec<BuiltMap>,
+    pub maps: Vec<BuiltMap>,
     /// Table 6.1 rows.
-    pub(crate) rows: Vec<MapRow>,
+    pub rows: Vec<MapRow>,
     /// Drawings per map type.
-    pub(crate) drawings: Vec<MapDrawing>,
+    pub drawings: Vec<MapDrawing>,
 }
 
 /// The Table 6.1 row of a patch map of `kind` (its backend's tag from `map`), with the counts
 /// of [`patch_counts`]; the file size is that of the map file it would save.
-pub(crate) fn patch_map_row(
+pub fn patch_map_row(
     kind: MapKind,
     map: &AnyMap,
     (planar, trimesh, triangles): (usize, usize, usize),
@@ -89,7 +89,7 @@ pub(crate) fn patch_map_row(
 
 /// Planar patches, trimesh patches, and triangles in all (planar patches triangulated), for
 /// Table 6.1.
-pub(crate) fn patch_counts(patches: &[Patch]) -> Result<(usize, usize, usize)> {
+pub fn patch_counts(patches: &[Patch]) -> Result<(usize, usize, usize)> {
     let (mut planar, mut trimesh, mut triangles) = (0, 0, 0);
     for p in patches {
         match p {
@@ -150,8 +150,8 @@ fn p3mm_raw(q: P3) -> P3 {
 }
 
 /// The drawing of patches: outlines of planar patches, triangles of trimesh patches
-/// (simplified by [`cluster_triangles`]).
-pub(crate) fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
+/// (simplified by clustering the triangles).
+pub fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
     let mut polygons = Vec::new();
     let mut triangles = Vec::new();
     for patch in patches {
@@ -174,7 +174,7 @@ pub(crate) fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
 
 /// The patches as one triangle mesh: planar patches triangulated, trimesh patches with their
 /// shared vertices.
-pub(crate) fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
+pub fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     let mut vertices: Vec<Point3> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     for (i, patch) in patches.iter().enumerate() {
@@ -201,7 +201,7 @@ pub(crate) fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]
 /// Extracts the planes, hybrid and trimesh maps' patches from the scans, loads each into every
 /// patch backend (keeping the planning backend's), builds the pc map, and writes each map's
 /// 3D file (`map-KIND.ply`).
-pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> Result<Built> {
+pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Result<Built> {
     let kinds = [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh];
     let bar =
         progress.bar((kinds.len() * (Backend::patch_backends().count() + 1) + 1) as u64, "maps");
@@ -277,7 +277,7 @@ pub(super) fn build_maps(lab: &Lab, progress: &Progress, files: &mut Files) -> R
 
 /// The Table 6.1 row and the drawing of a point-cloud (`pc`) map holding `points`, built in
 /// `build_seconds` — shared by the demo and `patchnav run`.
-pub(crate) fn point_map_entry(
+pub fn point_map_entry(
     map: &AnyMap,
     points: &[Point3],
     build_seconds: f64,

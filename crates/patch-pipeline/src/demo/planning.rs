@@ -5,14 +5,14 @@
 use super::explore::{Exploration, Target, explore};
 use super::maps::Built;
 use super::{Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, STEP, Settings, decimate, p3, p3mm};
-use crate::demo::model::{PlanRun, TimingCurve, VolumeSection};
-use crate::plan::{write_obj_paths, write_obj_roadmap};
-use crate::progress::Progress;
+use crate::Progress;
+use crate::lab::{common_box, corner_starts};
+use crate::polylines::{write_obj_paths, write_obj_roadmap};
+use crate::results::{PlanRun, TimingCurve, VolumeSection};
 use crate::scene_map::{BuiltMap, MapKind};
 use anyhow::{Context, Result, bail};
 use patch_core::Point3;
 use patch_map::AnyMap;
-use patch_pipeline::lab::{common_box, corner_starts};
 use roadmap::metrics::{turn_angles, upper_quartile};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlannerStatus,
@@ -50,7 +50,7 @@ fn planner(
 
 /// The first point free on every map near each of the four room corners, 1 m up (the lab
 /// experiments' starts).
-pub(super) fn starts(built: &Built) -> Result<Vec<Point3>> {
+pub fn starts(built: &Built) -> Result<Vec<Point3>> {
     corner_starts(&built.maps, &common_box(&built.maps), RADIUS, 4)
 }
 
@@ -58,7 +58,7 @@ pub(super) fn starts(built: &Built) -> Result<Vec<Point3>> {
 /// north-east corners and to the open floor in front of the rack's middle (the north-west
 /// corner lies behind the rack's end, in a 0.96 m gap that the scans' mixed pixels narrow further:
 /// a narrow-passage benchmark, not a demo; the timing runs still start there).
-pub(super) fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, Vec<Point3>)> {
+pub fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, Vec<Point3>)> {
     let (start, corners) = starts.split_first().context("no start")?;
     let mut goals: Vec<Point3> = corners.iter().take(2).copied().collect();
     let common = common_box(&built.maps);
@@ -88,30 +88,30 @@ pub(super) fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, V
 /// reached with their metrics (thesis §5.6), counters, and ([`drawn`](Self::drawn)) its
 /// roadmap's edges for the pictures; optionally the roadmap and paths written as OBJ under
 /// `files` (`roadmap-<tag>.obj`, `path-<tag>.obj`). Shared by the demo and `patchnav run`.
-pub(crate) struct RunRecord<'a> {
+pub struct RunRecord<'a> {
     /// The type of the map planned on.
-    pub(crate) kind: MapKind,
+    pub kind: MapKind,
     /// The map planned on.
-    pub(crate) map: &'a AnyMap,
+    pub map: &'a AnyMap,
     /// The planner's name in the report.
-    pub(crate) name: String,
+    pub name: String,
     /// The run's seed.
-    pub(crate) seed: u64,
+    pub seed: u64,
     /// Wall time of `solve`.
-    pub(crate) seconds: f64,
+    pub seconds: f64,
     /// The start.
-    pub(crate) start: Point3,
+    pub start: Point3,
     /// The goal centres.
-    pub(crate) goals: &'a [Point3],
+    pub goals: &'a [Point3],
     /// Keep the roadmap's edges (decimated) for the pictures.
-    pub(crate) drawn: bool,
+    pub drawn: bool,
     /// Write the roadmap and the paths as OBJ files under this tag.
-    pub(crate) obj_tag: Option<String>,
+    pub obj_tag: Option<String>,
 }
 
 impl RunRecord<'_> {
     /// The [`PlanRun`] of `run`; writes its OBJ files when [`obj_tag`](Self::obj_tag) is set.
-    pub(crate) fn record(self, run: &dyn Planner, files: &mut Files) -> Result<PlanRun> {
+    pub fn record(self, run: &dyn Planner, files: &mut Files) -> Result<PlanRun> {
         let paths: Vec<Vec<Point3>> =
             (0..self.goals.len()).filter_map(|g| run.path_to(g)).collect();
         let metrics: Vec<PathMetrics> = paths.iter().map(|p| PathMetrics::of(p)).collect();
@@ -172,13 +172,13 @@ fn space(map: &BuiltMap) -> Result<PlanningSpace> {
 /// each, and writes the first seed's roadmap and paths (`roadmap-MAP-PLANNER.obj`,
 /// `path-MAP-PLANNER.obj`). Only the first seed's run carries its (decimated) roadmap edges
 /// for the pictures; the other runs have metrics and paths only.
-pub(super) fn plan_all(
+pub fn plan_all(
     built: &Built,
     start: &Point3,
     goal_points: &[Point3],
     seed: u64,
     settings: &Settings,
-    progress: &Progress,
+    progress: &dyn Progress,
     files: &mut Files,
 ) -> Result<Vec<PlanRun>> {
     let goals: Vec<Goal> =
@@ -228,12 +228,12 @@ pub(super) fn plan_all(
 /// map type), and rasterises each map type's explored space (every edge, every free vertex)
 /// into one voxel grid covering all maps: the congruence table (Table 6.2) and a horizontal
 /// slice at the start height (Fig 6.1). See [`explore`].
-pub(super) fn timing_and_volume(
+pub fn timing_and_volume(
     built: &Built,
     starts: &[Point3],
     seed: u64,
     settings: &Settings,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> Result<(Vec<TimingCurve>, VolumeSection)> {
     let targets: Vec<Target<'_>> =
         built.maps.iter().map(|m| Target { name: m.kind.name().to_owned(), map: &m.map }).collect();

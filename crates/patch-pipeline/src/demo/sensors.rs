@@ -2,7 +2,7 @@
 //! the terrain snapshot (Ch. 4: the plane Hough transform and Algorithm 3).
 
 use super::Files;
-use crate::demo::model::{TerrainSection, TofSection};
+use crate::results::{TerrainSection, TofSection};
 use anyhow::{Context, Result};
 use hough_terrain::{
     HistogramStyle, HoughClassifier, HoughConfig, SectorClassifier, SectorGrid, SensorAxes,
@@ -39,7 +39,7 @@ fn terrain_spec() -> TerrainSpec {
 /// Simulates the ToF frame, filters it with the AAT and unwrapping (no low AT), scores it
 /// against the simulator's truth and writes the output cloud (`tof-cloud.ply`, with the
 /// `outcome` field) in the camera's optical frame.
-pub(super) fn tof(seed: u64, files: &mut Files) -> Result<TofSection> {
+pub fn tof(seed: u64, files: &mut Files) -> Result<TofSection> {
     let scene = tof_scene(TOF_SCENE)?;
     let simulator = TofSimulator::new(scene.sim.clone())?;
     let sim = simulator.simulate(&scene.scene, &scene.pose, seed)?;
@@ -92,7 +92,7 @@ fn truth_name(c: HoughClass) -> String {
 /// Simulates the SR-3000 on a robot at the origin looking along +x at the terrain scene,
 /// classifies the frame at 15° and per left/centre/right sector, and writes the frame
 /// (`terrain-frame.ply`) and its Hough space (`terrain-hough.png`, Fig 4.3 layout).
-pub(super) fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
+pub fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
     let spec = terrain_spec();
     let scene = terrain_scene(&spec, seed).context("building the terrain scene")?;
     let truth = scene.terrain_truth().context("a terrain scene has its truth")?.label;
@@ -141,7 +141,7 @@ pub(super) fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
 
 /// The pixel outcomes as [`TofSection::outcomes`] stores them: 0 kept, 1 unwrapped, 2 dropped,
 /// 3 not measured (range 0) — shared by the demo and `patchnav run`.
-pub(crate) fn outcome_codes(outcomes: &[PixelOutcome], measured: &[bool]) -> Vec<u8> {
+pub fn outcome_codes(outcomes: &[PixelOutcome], measured: &[bool]) -> Vec<u8> {
     outcomes
         .iter()
         .zip(measured)

@@ -6,7 +6,7 @@
 
 use super::maps::{Built, drawing};
 use super::{MAX_DRAWN, RADIUS, Settings, decimate, p3mm};
-use crate::demo::model::{MapSafety, SafetySection};
+use crate::results::{MapSafety, SafetySection};
 use crate::scene_map::{MapKind, patch_map, truth_patches};
 use anyhow::Result;
 use patch_map::{Attribution, Backend, StepSampling, compare_maps};
@@ -19,7 +19,7 @@ const MAX_LENGTH: f64 = 1.0;
 ///
 /// # Errors
 /// The scene's surfaces cannot be made into patches, or a bad sampling box.
-pub(crate) fn check(
+pub fn check(
     scene: &Scene,
     built: &Built,
     seed: u64,
