@@ -9,6 +9,8 @@
 //!   `results.json`.
 //! * [`demo`]: the demo's stages on the lab (sensors, maps, safety, planning, explored
 //!   volume), the pieces `patchnav run` reuses on the user's data.
+//! * [`input`]: reading a user's cloud (depth-image conventions, non-finite points).
+//! * [`preset`]: sensor presets ([`SensorPreset`]) of the extraction thresholds.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`lab`]: the thesis's §6.1 experiments on the simulated lab (Fig 6.4, Tables 6.1, 6.2,
 //!   6.4): its maps, corner starts, timed RRTs and explored volumes.
@@ -34,13 +36,16 @@
 //! ```
 
 pub mod demo;
+pub mod input;
 pub mod lab;
 pub mod polylines;
+pub mod preset;
 pub mod progress;
 pub mod report;
 pub mod results;
 pub mod scene_map;
 
+pub use preset::SensorPreset;
 pub use progress::{Progress, Silent, Ticker};
 pub use results::DemoResults;
 pub use scene_map::{MapKind, MapSource};

@@ -27,53 +27,19 @@ use crate::map::save_patches;
 use crate::names;
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use patch_core::na;
 use patch_core::triangulate::patch_triangles;
 use patch_core::{Isometry3, Patch, Point3, Real};
 use patch_extract::pipeline::{PipelineConfig, extract};
-use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use patch_extract::visibility::{Carved, VisibilityConfig};
 use patch_map::Backend;
+pub use patch_pipeline::SensorPreset;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// Sensor presets of the pipeline's thresholds.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SensorPreset {
-    /// Actuated laser range finder (S300-like, 1–3 cm noise).
-    Alrf,
-    /// The same sensor through the thesis's pipeline verbatim: no grazing planes, outlines as
-    /// the α-shape gives them (`PipelineConfig::alrf_thesis`).
-    AlrfThesis,
-    /// Time-of-flight range camera (SR-3000-like).
-    RangeCamera,
-    /// Structured-light depth camera (Kinect-like): noise growing with the square of the range.
-    StructuredLight,
-    /// Noise-free synthetic scans.
-    Exact,
-}
-
-impl SensorPreset {
-    /// The extraction pipeline's thresholds and the trimesh growing of the remainder for this
-    /// sensor.
-    pub fn configs(self) -> (PipelineConfig, TrimeshGrowConfig) {
-        match self {
-            SensorPreset::Alrf => (PipelineConfig::alrf(), TrimeshGrowConfig::alrf()),
-            SensorPreset::AlrfThesis => (PipelineConfig::alrf_thesis(), TrimeshGrowConfig::alrf()),
-            SensorPreset::RangeCamera => {
-                (PipelineConfig::range_camera(), TrimeshGrowConfig::range_camera())
-            }
-            SensorPreset::StructuredLight => {
-                (PipelineConfig::structured_light(), TrimeshGrowConfig::range_camera())
-            }
-            SensorPreset::Exact => (PipelineConfig::exact(), TrimeshGrowConfig::range_camera()),
-        }
-    }
-}
 
 /// Arguments of `patchnav extract`.
 #[derive(Args, Debug)]
@@ -91,7 +57,7 @@ pub struct ExtractArgs {
     #[arg(long)]
     pub spacing: Option<f64>,
     /// Threshold presets (segmentation noise model, trimesh growing, merging tolerances).
-    #[arg(long, value_enum, default_value_t = SensorPreset::Alrf)]
+    #[arg(long, value_parser = crate::names::all::<SensorPreset>(), default_value_t = SensorPreset::Alrf)]
     pub sensor: SensorPreset,
     /// Also grow trimesh patches on the points in no plane (the thesis's hybrid map); for
     /// unorganised scans through a spherical range-image grid, with splats for the points no
@@ -368,17 +334,6 @@ fn peak_rss_kib() -> Option<u64> {
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
 }
 
-/// A preset's name as the command line spells it.
-fn sensor_name(sensor: SensorPreset) -> &'static str {
-    match sensor {
-        SensorPreset::Alrf => "alrf",
-        SensorPreset::AlrfThesis => "alrf-thesis",
-        SensorPreset::RangeCamera => "range-camera",
-        SensorPreset::StructuredLight => "structured-light",
-        SensorPreset::Exact => "exact",
-    }
-}
-
 /// One result line (peers' FORMAT.md §4, kind `planes`) for this run.
 fn result_line(
     args: &ExtractArgs,
@@ -419,7 +374,7 @@ fn result_line(
         "rss_after_load_kib": rss_after_load,
         "peak_rss_kib": peak_rss_kib(),
         "params": {
-            "sensor": sensor_name(args.sensor),
+            "sensor": args.sensor.name(),
             "merge": config.merge.is_some(),
             "hybrid": args.hybrid,
             "sigma_0": seg.noise.sigma_0,

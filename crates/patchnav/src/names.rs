@@ -5,7 +5,8 @@
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use patch_map::Backend;
-use patch_pipeline::{MapKind, MapSource};
+use patch_pipeline::input::DepthConvention;
+use patch_pipeline::{MapKind, MapSource, SensorPreset};
 use roadmap::PlannerKind;
 use std::ffi::OsStr;
 use std::fmt;
@@ -54,6 +55,30 @@ impl Named for MapSource {
 
     fn description(self) -> &'static str {
         MapSource::description(self)
+    }
+}
+
+impl Named for DepthConvention {
+    const ALL: &'static [DepthConvention] = &DepthConvention::ALL;
+
+    fn name(self) -> &'static str {
+        DepthConvention::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        DepthConvention::description(self)
+    }
+}
+
+impl Named for SensorPreset {
+    const ALL: &'static [SensorPreset] = &SensorPreset::ALL;
+
+    fn name(self) -> &'static str {
+        SensorPreset::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        SensorPreset::description(self)
     }
 }
 

@@ -61,7 +61,7 @@
 //! `--quick` shrinks everything for tests (ALRF at 3°, a 88 × 72 camera, one pose, one map
 //! scan, smaller minimum region sizes). `--jsonl FILE` writes one JSON object per table row.
 
-use crate::input::{DepthCameraChoice, InputArgs, read_cloud};
+use crate::input::{InputArgs, read_cloud};
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
@@ -85,6 +85,7 @@ use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use patch_extract::{PlanarRegion, Segmentation};
 use patch_map::mapfile::{HEADER_LEN, MapCounts, write_map};
 use patch_map::{BBox6dMap, MapFile as _, PointCloudMap};
+use patch_pipeline::input::DepthConvention;
 use pointcloud::io::ply::{PlyWriteOptions, write_ply};
 use pointcloud::{BeamModel, PointCloud, SensorPose};
 use scene_sim::{
@@ -868,11 +869,11 @@ fn real_inputs(dir: &Path, out: &mut String) -> Result<Vec<(bool, SurveyInput)>>
     }
     // Kinect-class depth noise grows with the square of the range.
     let kinect = SegmentConfig::structured_light();
-    let files: [(&str, Option<DepthCameraChoice>, &str); 2] = [
+    let files: [(&str, Option<DepthConvention>, &str); 2] = [
         ("pcl_kinect_office/office1.pcd", None, "real: PCL Kinect office1.pcd (640×480)"),
         (
             "tum_rgbd_kinect_frame/TUM_depth.png",
-            Some(DepthCameraChoice::Tum),
+            Some(DepthConvention::Tum),
             "real: TUM RGB-D depth frame (640×480)",
         ),
     ];

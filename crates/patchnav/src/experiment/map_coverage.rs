@@ -8,13 +8,14 @@
 //! mesh holds (`patch_extract::spherical_grid`, an addition beyond the thesis).
 
 use crate::extract::SensorPreset;
-use crate::input::{DepthCameraChoice, InputArgs, read_cloud};
+use crate::input::{InputArgs, read_cloud};
 use crate::progress::Progress;
 use crate::scene_map::{MapKind, extracted_patches_with};
 use anyhow::{Context, Result};
 use clap::Args;
 use patch_core::{FromPatches, Patch, Point3, ProximityQuery, Real};
 use patch_map::{BBox6dMap, MapFile};
+use patch_pipeline::input::DepthConvention;
 use pointcloud::PointCloud;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -40,7 +41,7 @@ struct RealScan {
     /// The sensor preset of its kind.
     preset: SensorPreset,
     /// Depth-image convention, for PNG depth images.
-    depth_camera: Option<DepthCameraChoice>,
+    depth_camera: Option<DepthConvention>,
 }
 
 /// The scans measured: every real range scan of the folder that is a scene (not an object,
@@ -74,7 +75,7 @@ const SCANS: [RealScan; 9] = [
     RealScan {
         file: "tum_rgbd_kinect_frame/TUM_depth.png",
         preset: SensorPreset::StructuredLight,
-        depth_camera: Some(DepthCameraChoice::Tum),
+        depth_camera: Some(DepthConvention::Tum),
     },
     RealScan {
         file: "pcl_openni_grabber_boxes/frame_20121214T142255.814212.pcd",
@@ -152,7 +153,7 @@ pub fn coverage_row(
     dir: &Path,
     scan: &str,
     preset: SensorPreset,
-    depth_camera: Option<DepthCameraChoice>,
+    depth_camera: Option<DepthConvention>,
     sigmas: Real,
 ) -> Result<Option<CoverageRow>> {
     let path = dir.join(scan);

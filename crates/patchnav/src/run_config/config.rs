@@ -560,7 +560,7 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
         .map(|b| named_list("maps.backends", b, names::patch_backends()))
         .transpose()?;
     let sensor = match (&m.sensor, &input) {
-        (Some(s), Input::Scans { .. }) => choice("maps.sensor", s)?,
+        (Some(s), Input::Scans { .. }) => named("maps.sensor", s, names::all())?,
         (Some(_), _) => bail!("maps.sensor applies to `scans` input only"),
         (None, _) => SensorPreset::Alrf,
     };
