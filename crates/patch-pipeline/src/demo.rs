@@ -21,7 +21,7 @@
 //!   slower to plan on; the pc map in the point-cloud backend (Algorithm 10).
 //! * Robot radius 0.3 m, RRT step 1.0 m, each map sampled in its own box (as the lab
 //!   experiments). Starts and goals: the free points near the four room corners
-//!   ([`crate::lab`]); plans go from the first corner to the other three (goal
+//!   ([`crate::experiment::lab`]); plans go from the first corner to the other three (goal
 //!   tolerance 0.5 m) and stop when all are reached or the budget is spent. The planners are
 //!   thesis Algorithm 13 with a 5 % goal bias and Algorithm 14 (six neighbours), without the
 //!   §6.2.3 direct goal test: the corners see each other at 1 m height, so that test alone

@@ -12,8 +12,8 @@
 //! * [`input`]: reading a user's cloud (depth-image conventions, non-finite points).
 //! * [`preset`]: sensor presets ([`SensorPreset`]) of the extraction thresholds.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
-//! * [`lab`]: the thesis's §6.1 experiments on the simulated lab (Fig 6.4, Tables 6.1, 6.2,
-//!   6.4): its maps, corner starts, timed RRTs and explored volumes.
+//! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
+//!   [`experiment::lab`]).
 //! * [`report`]: the self-contained HTML page drawn from those results.
 //! * [`progress`]: how long steps say how far they got ([`Progress`]; [`Silent`] says nothing).
 //!
@@ -36,8 +36,8 @@
 //! ```
 
 pub mod demo;
+pub mod experiment;
 pub mod input;
-pub mod lab;
 pub mod polylines;
 pub mod preset;
 pub mod progress;

@@ -7,7 +7,7 @@
 //! RRTs fill the grid), or either alone.
 
 use crate::Progress;
-use crate::lab::{CheckpointTimer, checkpoints, explored};
+use crate::experiment::lab::{CheckpointTimer, checkpoints, explored};
 use crate::results::{TimingCurve, VolumeSection};
 use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};

@@ -6,7 +6,7 @@ use super::explore::{Exploration, Target, explore};
 use super::maps::Built;
 use super::{Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, STEP, Settings, decimate, p3, p3mm};
 use crate::Progress;
-use crate::lab::{common_box, corner_starts};
+use crate::experiment::lab::{common_box, corner_starts};
 use crate::polylines::{write_obj_paths, write_obj_roadmap};
 use crate::results::{PlanRun, TimingCurve, VolumeSection};
 use crate::scene_map::{BuiltMap, MapKind};

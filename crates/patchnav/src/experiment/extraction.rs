@@ -63,6 +63,7 @@
 
 use crate::input::{InputArgs, read_cloud};
 use crate::progress::Progress;
+use patch_pipeline::experiment::ByteCount;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use patch_core::triangulate::triangulate_polygon;
@@ -1212,19 +1213,6 @@ fn storage_section(out: &mut String, rows: &mut Vec<Value>, cases: &[Case]) -> R
          outline vertices are Table 6.1's median polygon size (Ch. 6 maps)."
     )?;
     Ok(())
-}
-
-/// Counts the bytes written (a map file's size without writing it).
-pub(super) struct ByteCount(pub(super) u64);
-
-impl std::io::Write for ByteCount {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.0 += buf.len() as u64;
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
 }
 
 fn mb(bytes: u64) -> String {

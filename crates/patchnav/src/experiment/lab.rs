@@ -6,7 +6,7 @@ use clap::Args;
 use patch_core::Real;
 use patch_extract::MixedPixelFix;
 use patch_map::Backend;
-use patch_pipeline::lab::{self, LabSetup, LabTimingSetup, LabVolumeSetup};
+use patch_pipeline::experiment::lab::{self, LabSetup, LabTimingSetup, LabVolumeSetup};
 use patch_pipeline::{MapKind, MapSource};
 use std::path::PathBuf;
 

@@ -21,7 +21,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::extraction::ByteCount;
+use patch_pipeline::experiment::ByteCount;
 
 /// Arguments of `patchnav experiment map-coverage`.
 #[derive(Args, Debug, Clone)]

@@ -21,7 +21,7 @@
 //! [`patch_extract::visibility`]); and `pc-no-phantoms`, `pc-no-phantoms-denoised`, what a
 //! perfect mixed-pixel filter would give (the simulator's own phantoms dropped).
 
-use super::extraction::ByteCount;
+use patch_pipeline::experiment::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
     MapKind, PcCleaning, ScanSetup, extracted_patches, extracted_patches_with, patch_map,
