@@ -5,6 +5,7 @@
 //!   starts, timed RRTs and explored volumes.
 
 pub mod lab;
+pub mod tof;
 
 /// A writer that only counts the bytes written: a file's size without the file.
 #[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]

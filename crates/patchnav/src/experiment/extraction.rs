@@ -63,7 +63,6 @@
 
 use crate::input::{InputArgs, read_cloud};
 use crate::progress::Progress;
-use patch_pipeline::experiment::ByteCount;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use patch_core::triangulate::triangulate_polygon;
@@ -86,6 +85,7 @@ use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use patch_extract::{PlanarRegion, Segmentation};
 use patch_map::mapfile::{HEADER_LEN, MapCounts, write_map};
 use patch_map::{BBox6dMap, MapFile as _, PointCloudMap};
+use patch_pipeline::experiment::ByteCount;
 use patch_pipeline::input::DepthConvention;
 use pointcloud::io::ply::{PlyWriteOptions, write_ply};
 use pointcloud::{BeamModel, PointCloud, SensorPose};

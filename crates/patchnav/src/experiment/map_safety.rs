@@ -21,7 +21,6 @@
 //! [`patch_extract::visibility`]); and `pc-no-phantoms`, `pc-no-phantoms-denoised`, what a
 //! perfect mixed-pixel filter would give (the simulator's own phantoms dropped).
 
-use patch_pipeline::experiment::ByteCount;
 use crate::progress::Progress;
 use crate::scene_map::{
     MapKind, PcCleaning, ScanSetup, extracted_patches, extracted_patches_with, patch_map,
@@ -37,6 +36,7 @@ use patch_extract::{
 use patch_map::{
     AnyMap, Attribution, Backend, MapComparison, PointCloudMap, StepSampling, compare_maps,
 };
+use patch_pipeline::experiment::ByteCount;
 use roadmap::{Goal, MaxIterations, PlannerKind, PlanningSpace, Problem, named_planner_on};
 use serde::Serialize;
 use std::fmt::Write as _;

@@ -1,15 +1,11 @@
-//! `patchnav experiment tof`: thesis Table 2.4 (the AAT against amplitude thresholds) on the
-//! six simulated scenes, with the metrics the thesis had no ground truth for, and the same
-//! detection on a real frame folded at a chosen non-ambiguity range.
+//! The command line of `patchnav experiment tof`: arguments that become
+//! [`patch_pipeline::experiment::tof`]'s settings; the experiment lives there.
 
 use crate::progress::Progress;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
+use patch_pipeline::experiment::tof::{self as lib, TofSetup};
 use pointcloud::Real;
-use sensor_tof::experiment::{
-    Method, SceneResult, ThesisDiscarded, evaluate_folded, evaluate_scene, quality_table, table_2_4,
-};
-use sensor_tof::scenes::all_scenes;
 use std::path::PathBuf;
 
 /// Arguments of `patchnav experiment tof`.
@@ -35,51 +31,20 @@ pub struct TofArgs {
     pub json: Option<PathBuf>,
 }
 
+impl TofArgs {
+    /// The library's settings.
+    pub fn setup(&self) -> TofSetup {
+        TofSetup {
+            seed: self.seed,
+            real: self.real.clone(),
+            fold: self.fold,
+            second_fold: self.second_fold,
+            json: self.json.clone(),
+        }
+    }
+}
+
 /// Runs `patchnav experiment tof`.
 pub fn run(args: &TofArgs, progress: &Progress) -> Result<()> {
-    let scenes = all_scenes()?;
-    let bar = progress.bar(scenes.len() as u64, "scenes");
-    let mut results = Vec::new();
-    for scene in &scenes {
-        results.push(evaluate_scene(scene, &Method::all(), args.seed)?);
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    progress.report(table_2_4(&results));
-    progress.report(quality_table(&results));
-    let mut folded = None;
-    if let Some(dir) = &args.real {
-        let meta = sensor_tof::io::read_meta(&dir.join("frame_meta.json"))?;
-        let amplitude = dir.join("normalized_amplitude_u16.png");
-        let frame =
-            sensor_tof::io::read_png_pair(&dir.join("radial_distance_u16.png"), &amplitude, &meta)
-                .with_context(|| format!("reading the frame in {}", dir.display()))?;
-        let noise = sensor_tof::io::read_png_pair(
-            &dir.join("radial_distance_noise_u16.png"),
-            &amplitude,
-            &meta,
-        )
-        .with_context(|| format!("reading the noise image in {}", dir.display()))?;
-        let f =
-            evaluate_folded(&frame, Some(noise.range()), args.fold, args.second_fold, args.seed)?;
-        progress.report(format!(
-            "real frame folded at {} m (second frequency {} m): {} measured pixels, {:.1} % wrapped; \
-             thresholds tuned on the even rows {:?}; scored on the odd rows (discarded % counts every pixel, \
-             also those the camera gave no distance):",
-            f.fold_m, f.second_fold_m, f.measured, f.wrapped_percent, f.thresholds
-        ));
-        let as_scene = SceneResult {
-            scene: "real-folded".into(),
-            wrapped_percent: f.wrapped_percent,
-            thesis: ThesisDiscarded { aat: Real::NAN, at160: Real::NAN, at240: None },
-            results: f.results.clone(),
-        };
-        progress.report(quality_table(std::slice::from_ref(&as_scene)));
-        folded = Some(f);
-    }
-    if let Some(path) = &args.json {
-        let value = serde_json::json!({ "scenes": results, "folded": folded });
-        pointcloud::io::write_bytes_atomically(path, serde_json::to_string_pretty(&value)? + "\n")?;
-    }
-    Ok(())
+    lib::run(&args.setup(), progress)
 }
