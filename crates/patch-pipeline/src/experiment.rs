@@ -5,6 +5,7 @@
 //!   starts, timed RRTs and explored volumes.
 
 pub mod lab;
+pub mod map_safety;
 pub mod tof;
 
 /// A writer that only counts the bytes written: a file's size without the file.
