@@ -5,6 +5,7 @@
 //!   starts, timed RRTs and explored volumes.
 
 pub mod lab;
+pub mod map_coverage;
 pub mod map_safety;
 pub mod tof;
 
