@@ -4,6 +4,7 @@
 //! * [`lab`]: §6.1 on the simulated lab (Fig 6.4, Tables 6.1, 6.2, 6.4): its maps, corner
 //!   starts, timed RRTs and explored volumes.
 
+pub mod extraction;
 pub mod lab;
 pub mod map_coverage;
 pub mod map_safety;

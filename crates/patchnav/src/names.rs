@@ -5,6 +5,7 @@
 
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use patch_map::Backend;
+use patch_pipeline::experiment::extraction::RegionSource;
 use patch_pipeline::input::DepthConvention;
 use patch_pipeline::{MapKind, MapSource, SensorPreset};
 use roadmap::PlannerKind;
@@ -79,6 +80,18 @@ impl Named for SensorPreset {
 
     fn description(self) -> &'static str {
         SensorPreset::description(self)
+    }
+}
+
+impl Named for RegionSource {
+    const ALL: &'static [RegionSource] = &RegionSource::ALL;
+
+    fn name(self) -> &'static str {
+        RegionSource::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        RegionSource::description(self)
     }
 }
 
