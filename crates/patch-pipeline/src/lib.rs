@@ -11,6 +11,8 @@
 //!   volume), the pieces `patchnav run` reuses on the user's data.
 //! * [`input`]: reading a user's cloud (depth-image conventions, non-finite points).
 //! * [`preset`]: sensor presets ([`SensorPreset`]) of the extraction thresholds.
+//! * [`problem`]: the runs of a planning problem of the shared exchange format and their
+//!   result rows.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
@@ -40,6 +42,7 @@ pub mod experiment;
 pub mod input;
 pub mod polylines;
 pub mod preset;
+pub mod problem;
 pub mod progress;
 pub mod report;
 pub mod results;

@@ -7,6 +7,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use patch_map::Backend;
 use patch_pipeline::experiment::extraction::RegionSource;
 use patch_pipeline::input::DepthConvention;
+use patch_pipeline::problem::Mode;
 use patch_pipeline::{MapKind, MapSource, SensorPreset};
 use roadmap::PlannerKind;
 use std::ffi::OsStr;
@@ -92,6 +93,18 @@ impl Named for RegionSource {
 
     fn description(self) -> &'static str {
         RegionSource::description(self)
+    }
+}
+
+impl Named for Mode {
+    const ALL: &'static [Mode] = &Mode::ALL;
+
+    fn name(self) -> &'static str {
+        Mode::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        Mode::description(self)
     }
 }
 

@@ -154,8 +154,8 @@ impl std::str::FromStr for RegionSource {
     }
 }
 
-/// The settings of `patchnav experiment extraction`.
-#[derive(Clone, Debug)]
+/// The settings (defaults: the command line's) of `patchnav experiment extraction`.
+#[derive(Clone, Debug, PartialEq)]
 pub struct ExtractionSetup {
     /// Scan poses per sensor and noise level.
     pub poses: usize,
@@ -174,6 +174,21 @@ pub struct ExtractionSetup {
     pub quick: bool,
     /// Also write every table row as a JSON object per line to this file.
     pub jsonl: Option<PathBuf>,
+}
+
+impl Default for ExtractionSetup {
+    fn default() -> ExtractionSetup {
+        ExtractionSetup {
+            poses: 3,
+            seed: 7,
+            alrf_step_deg: 0.5,
+            map_scans: 29,
+            regions: RegionSource::Segmented,
+            real: PathBuf::from("../shared/data/real"),
+            quick: false,
+            jsonl: None,
+        }
+    }
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

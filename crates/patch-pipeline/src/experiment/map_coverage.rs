@@ -21,13 +21,19 @@ use std::path::{Path, PathBuf};
 
 use crate::experiment::ByteCount;
 
-/// The settings of `patchnav experiment map-coverage`.
-#[derive(Debug, Clone)]
+/// The settings (defaults: the command line's) of `patchnav experiment map-coverage`.
+#[derive(Clone, Debug, PartialEq)]
 pub struct MapCoverageSetup {
     /// The real-data folder (each scan's folder holds a SOURCE.md).
     pub real_dir: PathBuf,
     /// Covered within this many σ(r) of a patch.
     pub sigmas: Real,
+}
+
+impl Default for MapCoverageSetup {
+    fn default() -> MapCoverageSetup {
+        MapCoverageSetup { real_dir: PathBuf::from("../shared/data/real"), sigmas: 3.0 }
+    }
 }
 
 /// One real scan and how to read it.

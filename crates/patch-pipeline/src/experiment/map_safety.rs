@@ -45,8 +45,8 @@ use std::time::Instant;
 /// `pc-no-phantoms` row (3σ of the S300 model).
 const PHANTOM_TOLERANCE: Real = 0.09;
 
-/// The settings of `patchnav experiment map-safety`.
-#[derive(Debug, Clone)]
+/// The settings (defaults: the command line's) of `patchnav experiment map-safety`.
+#[derive(Clone, Debug, PartialEq)]
 pub struct MapSafetySetup {
     /// Scenes, comma-separated (`lab`, `office`).
     pub scenes: Vec<String>,

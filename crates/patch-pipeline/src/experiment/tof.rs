@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 /// The settings of the ToF experiment (`patchnav experiment tof`); [`Default`] is the
 /// command line's.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TofSetup {
     /// Seed of the simulated noise.
     pub seed: u64,

@@ -62,3 +62,39 @@ pub fn run(command: &ExperimentCommand, progress: &Progress) -> Result<()> {
         ExperimentCommand::MapCoverage(args) => map_coverage::run(args, progress),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser, Debug)]
+    struct Cli {
+        #[command(subcommand)]
+        experiment: ExperimentCommand,
+    }
+
+    fn parse(name: &str) -> ExperimentCommand {
+        Cli::try_parse_from(["cli", name]).unwrap().experiment
+    }
+
+    /// The command line's defaults are the library's, so a library user gets the figures the
+    /// docs print with the bare command.
+    #[test]
+    fn every_experiment_defaults_to_the_library_defaults() {
+        use patch_pipeline::experiment::{extraction, map_coverage, map_safety, office, tof};
+        let ExperimentCommand::Office(a) = parse("office") else { panic!() };
+        assert_eq!(a.setup(), office::OfficeSetup::default());
+        let ExperimentCommand::LabTiming(a) = parse("lab-timing") else { panic!() };
+        assert_eq!(a.lab.setup(), patch_pipeline::experiment::lab::LabSetup::default());
+        assert_eq!((a.seeds, a.checkpoints, a.out.clone()), (24, 20, None));
+        let ExperimentCommand::Extraction(a) = parse("extraction") else { panic!() };
+        assert_eq!(a.setup(), extraction::ExtractionSetup::default());
+        let ExperimentCommand::MapSafety(a) = parse("map-safety") else { panic!() };
+        assert_eq!(a.setup(), map_safety::MapSafetySetup::default());
+        let ExperimentCommand::MapCoverage(a) = parse("map-coverage") else { panic!() };
+        assert_eq!(a.setup(), map_coverage::MapCoverageSetup::default());
+        let ExperimentCommand::Tof(a) = parse("tof") else { panic!() };
+        assert_eq!(a.setup(), tof::TofSetup::default());
+    }
+}
