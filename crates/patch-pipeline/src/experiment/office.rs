@@ -1,8 +1,8 @@
 //! `patchnav experiment office`: the thesis's preliminary experiment (§5.5.3–5.5.4, Tables
 //! 5.3–5.11; spec §5.1) on the office floor plan of the shared benchmark.
 //!
-//! Every planner of [`PLANNERS`] runs on every backend of [`BACKENDS`] it can run on, once per
-//! seed `0..N`. A run reaches all four regions of interest (ROIs) from the central start with
+//! Every planner of the planner table (`PLANNERS`) runs on every backend of the backend table
+//! (`BACKENDS`) it can run on, once per seed `0..N`. A run reaches all four regions of interest (ROIs) from the central start with
 //! one growing tree or roadmap and stops there, or after the iteration cap (the `roi` mode of
 //! `patchnav plan --problem`, whose problem reading, map building, planner construction and
 //! result rows it shares). Each map is built once per backend; only `solve` is timed.
