@@ -13,6 +13,7 @@
 //! * [`preset`]: sensor presets ([`SensorPreset`]) of the extraction thresholds.
 //! * [`problem`]: the runs of a planning problem of the shared exchange format and their
 //!   result rows.
+//! * [`terrain`]: a frame's terrain class and drivability by the plane Hough transform.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
@@ -47,6 +48,7 @@ pub mod progress;
 pub mod report;
 pub mod results;
 pub mod scene_map;
+pub mod terrain;
 
 pub use preset::SensorPreset;
 pub use progress::{Progress, Silent, Ticker};

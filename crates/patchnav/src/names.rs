@@ -8,6 +8,7 @@ use patch_map::Backend;
 use patch_pipeline::experiment::extraction::RegionSource;
 use patch_pipeline::input::DepthConvention;
 use patch_pipeline::problem::Mode;
+use patch_pipeline::terrain::AxesChoice;
 use patch_pipeline::{MapKind, MapSource, SensorPreset};
 use roadmap::PlannerKind;
 use std::ffi::OsStr;
@@ -105,6 +106,18 @@ impl Named for Mode {
 
     fn description(self) -> &'static str {
         Mode::description(self)
+    }
+}
+
+impl Named for AxesChoice {
+    const ALL: &'static [AxesChoice] = &AxesChoice::ALL;
+
+    fn name(self) -> &'static str {
+        AxesChoice::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        AxesChoice::description(self)
     }
 }
 

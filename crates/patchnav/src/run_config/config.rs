@@ -8,11 +8,10 @@ use crate::demo::pipeline::explore::{EXPLORE_PLANNERS, MAX_VOLUME_MAPS};
 use crate::extract::SensorPreset;
 use crate::names::{self, NameParser, Named};
 use crate::scene_map::{MapKind, Tessellation};
-use crate::terrain::AxesChoice;
 use anyhow::{Context, Result, bail};
-use clap::ValueEnum;
 use patch_core::{Point3, Real};
 use patch_map::Backend;
+use patch_pipeline::terrain::AxesChoice;
 use roadmap::PlannerKind;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -310,17 +309,6 @@ pub fn allowed_types(input: &Input) -> &'static [MapKind] {
         Input::Map(_) => &MapKind::ALL,
         Input::Cloud(_) => &[MapKind::Pc],
     }
-}
-
-/// One of a value enum's names, or an error naming `key` and the choices.
-fn choice<T: ValueEnum>(key: &str, text: &str) -> Result<T> {
-    T::from_str(text, false).map_err(|_| {
-        let names: Vec<String> = T::value_variants()
-            .iter()
-            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_owned()))
-            .collect();
-        anyhow::anyhow!("{key}: unknown value `{text}`; choose one of: {}", names.join(", "))
-    })
 }
 
 /// One of a library vocabulary's names that `parser` accepts, or an error naming `key` and the
@@ -683,7 +671,11 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
                 resolution,
                 sensor_height,
                 pitch,
-                axes: t.axes.as_deref().map(|a| choice("terrain.axes", a)).transpose()?,
+                axes: t
+                    .axes
+                    .as_deref()
+                    .map(|a| named("terrain.axes", a, names::all()))
+                    .transpose()?,
                 max_range: t.max_range,
                 sectors,
             })

@@ -24,6 +24,7 @@ use patch_map::{
     AnyMap, Backend, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh,
     sample_patch_points,
 };
+use patch_pipeline::terrain::TerrainSetup;
 use pointcloud::{Aabb, PointCloud, SensorPose};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PlannerKind, PlannerStatus, PlanningSpace, Problem,
@@ -537,20 +538,16 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
 /// Classifies the terrain frame as `patchnav terrain --sectors N` does and writes its Hough
 /// space (`terrain-hough.png`, Fig 4.3 layout).
 fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
-    let args = crate::terrain::TerrainArgs {
-        frame: t.frame.clone(),
-        resolution: t.resolution,
+    let setup = TerrainSetup {
         sectors: Some(t.sectors),
-        hough_png: None,
         axes: t.axes,
+        resolution: t.resolution,
         sensor_height: t.sensor_height,
         pitch: t.pitch,
         max_range: t.max_range,
-        repeat: 1,
-        json: false,
-        input: InputArgs { skip_non_finite: false, depth_camera: None },
+        ..TerrainSetup::new(t.frame.clone())
     };
-    let c = crate::terrain::classify(&args).context("[terrain]")?;
+    let c = patch_pipeline::terrain::classify(&setup).context("[terrain]")?;
     let mut png = Vec::new();
     hough_png(
         c.classifier.accumulator(),
