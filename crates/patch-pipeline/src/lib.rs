@@ -14,6 +14,7 @@
 //! * [`problem`]: the runs of a planning problem of the shared exchange format and their
 //!   result rows.
 //! * [`terrain`]: a frame's terrain class and drivability by the plane Hough transform.
+//! * [`tof`]: reading and filtering a time-of-flight frame (AAT, unwrapping, two frequencies).
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
@@ -49,6 +50,7 @@ pub mod report;
 pub mod results;
 pub mod scene_map;
 pub mod terrain;
+pub mod tof;
 
 pub use preset::SensorPreset;
 pub use progress::{Progress, Silent, Ticker};

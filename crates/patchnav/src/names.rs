@@ -9,6 +9,7 @@ use patch_pipeline::experiment::extraction::RegionSource;
 use patch_pipeline::input::DepthConvention;
 use patch_pipeline::problem::Mode;
 use patch_pipeline::terrain::AxesChoice;
+use patch_pipeline::tof::Method;
 use patch_pipeline::{MapKind, MapSource, SensorPreset};
 use roadmap::PlannerKind;
 use std::ffi::OsStr;
@@ -118,6 +119,18 @@ impl Named for AxesChoice {
 
     fn description(self) -> &'static str {
         AxesChoice::description(self)
+    }
+}
+
+impl Named for Method {
+    const ALL: &'static [Method] = &Method::ALL;
+
+    fn name(self) -> &'static str {
+        Method::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        Method::description(self)
     }
 }
 

@@ -16,20 +16,15 @@
 //! camera.
 
 use crate::progress::Progress;
-use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use anyhow::Result;
+use clap::Args;
+use patch_pipeline::tof::{FilterSetup, FrameSource, Method, filter_frame, load_frame};
 use pointcloud::Real;
-use pointcloud::io::ReadOptions;
-use sensor_tof::calibrate::{Calibration, CalibrationOptions, fit_parabola, white_wall_table};
-use sensor_tof::io::{
-    DEFAULT_AAT, FrameMeta, frame_from_cloud, read_json, read_meta, read_png_pair,
-    read_png_pair_with_confidence, write_json, write_rgb_png,
-};
-use sensor_tof::two_freq::{SR3000_PHASE_NOISE_RAD, TwoFreqConfig, unwrap_two_frequencies};
-use sensor_tof::{
-    AatRange, FilterConfig, FilterOutput, NegativeIllumination, PixelOutcome, TofFilter, TofFrame,
-};
-use std::path::{Path, PathBuf};
+use sensor_tof::calibrate::{CalibrationOptions, fit_parabola, white_wall_table};
+use sensor_tof::io::{write_json, write_rgb_png};
+use sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD;
+use sensor_tof::{AatRange, FilterOutput, PixelOutcome, TofFrame};
+use std::path::PathBuf;
 
 /// Time-of-flight subcommands.
 #[derive(Debug, clap::Subcommand)]
@@ -69,17 +64,6 @@ pub struct FrameArgs {
     pub meta: PathBuf,
 }
 
-/// Which filter.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// The adaptive amplitude threshold (Eq 2.4) with the sidecar's illumination model.
-    Aat,
-    /// The plain amplitude threshold `--at`.
-    At,
-    /// Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`).
-    TwoFreq,
-}
-
 /// Arguments of `patchnav tof filter`.
 #[derive(Debug, Args)]
 pub struct FilterArgs {
@@ -90,7 +74,7 @@ pub struct FilterArgs {
     #[arg(long, conflicts_with_all = ["range", "amplitude", "confidence"])]
     pub cloud: Option<PathBuf>,
     /// The filter.
-    #[arg(long, value_enum, default_value_t = Method::Aat)]
+    #[arg(long, value_parser = crate::names::all::<Method>(), default_value_t = Method::Aat)]
     pub method: Method,
     /// The plain amplitude threshold of `--method at` (the thesis's baselines: 160 and 240).
     #[arg(long, default_value_t = 160.0)]
@@ -179,6 +163,42 @@ pub struct CalibrateArgs {
     pub out: PathBuf,
 }
 
+impl FrameArgs {
+    /// The library's frame source.
+    pub fn source(&self) -> FrameSource {
+        FrameSource {
+            range: self.range.clone(),
+            amplitude: self.amplitude.clone(),
+            confidence: self.confidence.clone(),
+            meta: self.meta.clone(),
+        }
+    }
+}
+
+impl FilterArgs {
+    /// The library's settings (without the output options).
+    pub fn setup(&self) -> FilterSetup {
+        FilterSetup {
+            frame: self.frame.source(),
+            cloud: self.cloud.clone(),
+            method: self.method,
+            at: self.at,
+            aat: self.aat,
+            calibration: self.calibration.clone(),
+            unwrap: self.unwrap,
+            low_at: self.low_at,
+            radial: self.radial,
+            clamp_corners: self.clamp_corners,
+            range2: self.range2.clone(),
+            amplitude2: self.amplitude2.clone(),
+            meta2: self.meta2.clone(),
+            max_range: self.max_range,
+            phase_noise: self.phase_noise,
+            min_amplitude: self.min_amplitude,
+        }
+    }
+}
+
 /// Runs a `patchnav tof` subcommand.
 pub fn run(command: &TofCommand, progress: &Progress) -> Result<()> {
     match command {
@@ -188,117 +208,8 @@ pub fn run(command: &TofCommand, progress: &Progress) -> Result<()> {
     }
 }
 
-/// Reads the frame the arguments name (PNG pair or `cloud`) and its sidecar.
-fn load_frame(args: &FrameArgs, cloud: Option<&Path>) -> Result<(TofFrame, FrameMeta)> {
-    let meta = read_meta(&args.meta)?;
-    let frame = match (cloud, &args.range, &args.amplitude) {
-        (Some(path), _, _) => {
-            let cloud = pointcloud::io::read_cloud(path, &ReadOptions::STRICT)?;
-            frame_from_cloud(&cloud, &meta.camera()?, meta.range_kind)
-                .with_context(|| format!("{}", path.display()))?
-        }
-        (None, Some(r), Some(a)) => match &args.confidence {
-            Some(c) => read_png_pair_with_confidence(r, a, c, &meta)?,
-            None => read_png_pair(r, a, &meta)?,
-        },
-        _ => bail!("no frame: give --range and --amplitude, or a cloud"),
-    };
-    Ok((frame, meta))
-}
-
-/// Reads the frame the arguments name and filters it as `--method` says: the frame, the
-/// filter's output and the method's name (e.g. `AAT 0.2`).
-///
-/// # Errors
-/// An unreadable frame or sidecar, no AAT parameters for `--method aat`, a parameter out of
-/// range, or the filter refusing the frame.
-pub(crate) fn filter_frame(args: &FilterArgs) -> Result<(TofFrame, FilterOutput, String)> {
-    let (frame, meta) = load_frame(&args.frame, args.cloud.as_deref())?;
-    let (output, name) = match args.method {
-        Method::At => {
-            if args.unwrap {
-                bail!("--unwrap needs --method aat: a plain AT flags dark pixels at any range");
-            }
-            let f = TofFilter::new(frame.camera(), frame.kind(), &FilterConfig::at(args.at))?;
-            (f.run(&frame)?, format!("AT {}", args.at))
-        }
-        Method::Aat => {
-            let mut aat = match &args.calibration {
-                Some(path) => {
-                    let c: Calibration = read_json(path)?;
-                    let (w, h) = (frame.camera().width, frame.camera().height);
-                    if (c.width, c.height) != (w, h) {
-                        bail!(
-                            "{}: calibrated on {} × {} frames, this one is {w} × {h}",
-                            path.display(),
-                            c.width,
-                            c.height
-                        );
-                    }
-                    // The sidecar's threshold (else the thesis's 0.2) with this illumination.
-                    let threshold = meta.aat()?.map_or(DEFAULT_AAT, |a| a.threshold);
-                    c.aat_config(threshold)
-                }
-                None => meta.aat()?.with_context(|| {
-                    format!(
-                        "{}: no AAT parameters (give an `aat` block or a camera preset, or \
-                         --calibration)",
-                        args.frame.meta.display()
-                    )
-                })?,
-            };
-            if let Some(t) = args.aat {
-                aat.threshold = t;
-            }
-            if args.radial {
-                aat.range = AatRange::Radial;
-            }
-            if let Some(fraction) = args.clamp_corners {
-                if !(fraction.is_finite() && fraction > 0.0 && fraction <= 1.0) {
-                    bail!("--clamp-corners {fraction}: want a fraction in (0, 1]");
-                }
-                let aw = sensor_tof::filter::illumination_table(&aat.illumination, frame.camera())?;
-                let max = aw.iter().copied().fold(Real::NEG_INFINITY, Real::max);
-                aat.negative =
-                    NegativeIllumination::Clamp((fraction * max).max(Real::MIN_POSITIVE));
-            }
-            let name = format!("AAT {}", aat.threshold);
-            let config = if args.unwrap {
-                FilterConfig::aat_unwrap(aat, args.low_at)
-            } else {
-                FilterConfig::aat(aat)
-            };
-            (TofFilter::new(frame.camera(), frame.kind(), &config)?.run(&frame)?, name)
-        }
-        Method::TwoFreq => {
-            let (Some(r2), Some(a2), Some(m2)) = (&args.range2, &args.amplitude2, &args.meta2)
-            else {
-                bail!("--method two-freq needs --range2, --amplitude2 and --meta2");
-            };
-            let meta2 = read_meta(m2)?;
-            let frame2 = read_png_pair(r2, a2, &meta2)?.converted(frame.kind());
-            let mut config = TwoFreqConfig::for_pair(
-                meta.modulation_hz,
-                meta2.modulation_hz,
-                args.max_range,
-                args.phase_noise,
-            )?;
-            config.min_amplitude = args.min_amplitude;
-            let mut out = FilterOutput::default();
-            unwrap_two_frequencies(&frame, &frame2, &config, &mut out)?;
-            let name = format!(
-                "two-frequency {} + {} MHz",
-                meta.modulation_hz / 1e6,
-                meta2.modulation_hz / 1e6
-            );
-            (out, name)
-        }
-    };
-    Ok((frame, output, name))
-}
-
 fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
-    let (frame, output, name) = filter_frame(args)?;
+    let (frame, output, name) = filter_frame(&args.setup())?;
     let mut written = output.clone();
     if args.safe {
         for (o, r) in written.outcomes.iter_mut().zip(written.radial.iter_mut()) {
@@ -356,7 +267,7 @@ fn outcome_image(frame: &TofFrame, out: &FilterOutput) -> Vec<u8> {
 }
 
 fn calibrate(args: &CalibrateArgs, progress: &Progress) -> Result<()> {
-    let (frame, _) = load_frame(&args.frame, args.white_wall.as_deref())?;
+    let (frame, _) = load_frame(&args.frame.source(), args.white_wall.as_deref())?;
     let options = CalibrationOptions {
         range: if args.radial { AatRange::Radial } else { AatRange::Depth },
         fixed_curvature: args.fixed_curvature,

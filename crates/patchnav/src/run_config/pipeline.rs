@@ -25,6 +25,7 @@ use patch_map::{
     sample_patch_points,
 };
 use patch_pipeline::terrain::TerrainSetup;
+use patch_pipeline::tof::{FilterSetup, FrameSource, Method, filter_frame};
 use pointcloud::{Aabb, PointCloud, SensorPose};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PlannerKind, PlannerStatus, PlanningSpace, Problem,
@@ -479,15 +480,15 @@ fn plan(
 /// simulation, the wrapped, unwrapped-correctly and wrong percentages are unknown (NaN; `null`
 /// in `results.json`, a dash in the report).
 fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
-    let args = crate::tof::FilterArgs {
-        frame: crate::tof::FrameArgs {
+    let setup = FilterSetup {
+        frame: FrameSource {
             range: Some(t.range.clone()),
             amplitude: Some(t.amplitude.clone()),
             confidence: t.confidence.clone(),
             meta: t.meta.clone(),
         },
         cloud: None,
-        method: crate::tof::Method::Aat,
+        method: Method::Aat,
         at: 160.0,
         aat: t.aat,
         calibration: None,
@@ -501,19 +502,16 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
         max_range: 29.5,
         phase_noise: sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD,
         min_amplitude: None,
-        out: files.path("tof-cloud.ply"),
-        png: None,
-        dense: false,
-        safe: false,
     };
+    let out_path = files.path("tof-cloud.ply");
     let t0 = Instant::now();
-    let (frame, out, name) = crate::tof::filter_frame(&args).context("[tof]")?;
+    let (frame, out, name) = filter_frame(&setup).context("[tof]")?;
     let millis = t0.elapsed().as_secs_f64() * 1e3;
     let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
     let outcomes = crate::demo::pipeline::sensors::outcome_codes(&out.outcomes, &measured);
     if write_3d {
         let cloud = out.to_cloud(&frame, false);
-        pointcloud::io::write_cloud(&args.out, &cloud)?;
+        pointcloud::io::write_cloud(&out_path, &cloud)?;
         files.add(
             "ToF output cloud (camera frame; field `outcome`: 0 kept, 1 unwrapped)",
             "tof-cloud.ply",
