@@ -9,12 +9,15 @@
 //!   `results.json`.
 //! * [`demo`]: the demo's stages on the lab (sensors, maps, safety, planning, explored
 //!   volume), the pieces `patchnav run` reuses on the user's data.
+//! * [`files`]: scan poses and map files.
 //! * [`input`]: reading a user's cloud (depth-image conventions, non-finite points).
 //! * [`preset`]: sensor presets ([`SensorPreset`]) of the extraction thresholds.
 //! * [`problem`]: the runs of a planning problem of the shared exchange format and their
 //!   result rows.
 //! * [`terrain`]: a frame's terrain class and drivability by the plane Hough transform.
 //! * [`tof`]: reading and filtering a time-of-flight frame (AAT, unwrapping, two frequencies).
+//! * [`names`]: every vocabulary by name ([`names::Named`], [`names::NameParser`]).
+//! * [`run_config`]: `patchnav run`, the demo's job on the user's data from a TOML file.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
@@ -41,13 +44,16 @@
 
 pub mod demo;
 pub mod experiment;
+pub mod files;
 pub mod input;
+pub mod names;
 pub mod polylines;
 pub mod preset;
 pub mod problem;
 pub mod progress;
 pub mod report;
 pub mod results;
+pub mod run_config;
 pub mod scene_map;
 pub mod terrain;
 pub mod tof;

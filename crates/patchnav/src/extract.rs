@@ -23,21 +23,19 @@
 //! | `peak_rss_kib`, `rss_after_load_kib` | `VmHWM` of `/proc/self/status` at the end and after reading (`null` elsewhere) |
 
 use crate::input::InputArgs;
-use crate::map::save_patches;
 use crate::names;
 use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use patch_core::na;
 use patch_core::triangulate::patch_triangles;
-use patch_core::{Isometry3, Patch, Point3, Real};
+use patch_core::{Patch, Point3};
 use patch_extract::pipeline::{PipelineConfig, extract};
 use patch_extract::visibility::{Carved, VisibilityConfig};
 use patch_map::Backend;
 pub use patch_pipeline::SensorPreset;
+use patch_pipeline::files::{read_poses, save_patches};
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
-use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -116,50 +114,6 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
         config.slab_thickness = (t != 0.0).then_some(t);
     }
     config
-}
-
-/// Reads a `poses.json`: file name → `world_from_sensor`.
-pub(crate) fn read_poses(path: &Path) -> Result<HashMap<String, Isometry3>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
-    let scans = v
-        .get("scans")
-        .and_then(Value::as_array)
-        .with_context(|| format!("{}: no `scans` array", path.display()))?;
-    let mut out = HashMap::new();
-    for (i, s) in scans.iter().enumerate() {
-        let what = || format!("{}: scans[{i}]", path.display());
-        let file = s
-            .get("file")
-            .and_then(Value::as_str)
-            .with_context(|| format!("{}: `file` is missing", what()))?;
-        let rows = s
-            .get("world_from_sensor")
-            .and_then(Value::as_array)
-            .with_context(|| format!("{}: `world_from_sensor` is missing", what()))?;
-        let m: Vec<Real> = rows
-            .iter()
-            .flat_map(|r| r.as_array().into_iter().flatten())
-            .map(|x| x.as_f64().unwrap_or(Real::NAN))
-            .collect();
-        if m.len() != 16 || !m.iter().all(|x| x.is_finite()) {
-            bail!("{}: `world_from_sensor` is not 4 rows of 4 finite numbers", what());
-        }
-        let m = na::Matrix4::from_row_slice(&m);
-        let r = m.fixed_view::<3, 3>(0, 0).into_owned();
-        if (r.transpose() * r - na::Matrix3::identity()).norm() > 1e-6
-            || r.determinant() < 0.0
-            || m.row(3).transpose() != na::Vector4::new(0.0, 0.0, 0.0, 1.0)
-        {
-            bail!("{}: `world_from_sensor` is not a rigid transform", what());
-        }
-        let rotation = na::UnitQuaternion::from_matrix(&r);
-        let translation = na::Translation3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]);
-        out.insert(file.to_owned(), Isometry3::from_parts(translation, rotation));
-    }
-    Ok(out)
 }
 
 fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<Vec<PointCloud>> {
@@ -435,6 +389,7 @@ fn write_polygons(path: &Path, map: &str, patches: &[Patch]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use patch_core::Real;
 
     /// A 2 m × 2 m wall 2 m in front of the sensor, 5 cm grid, unorganised.
     fn wall(path: &Path) {

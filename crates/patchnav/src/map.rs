@@ -29,9 +29,10 @@ use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix, PipelineConfig, TrimeshGrowConfig};
 use patch_map::mapfile::read_header;
 use patch_map::{
-    AnyMap, AnyMapError, Attribution, Backend, MeshToPatchesConfig, PointCloudMap, StepSampling,
-    compare_maps, load_any, planar_patches_from_mesh,
+    AnyMap, Attribution, Backend, MeshToPatchesConfig, PointCloudMap, StepSampling, compare_maps,
+    planar_patches_from_mesh,
 };
+use patch_pipeline::files::{box_text, open_map, save_map, save_patches};
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
 use std::fs::File;
@@ -266,19 +267,6 @@ fn load_source(input: &Path, options: &InputArgs, progress: &Progress) -> Result
     }
 }
 
-/// Reads a map file of any backend.
-pub fn open_map(path: &Path) -> Result<AnyMap> {
-    let file = File::open(path).with_context(|| format!("opening {}", path.display()))?;
-    load_any(BufReader::new(file)).with_context(|| format!("reading {}", path.display()))
-}
-
-fn save(map: &AnyMap, out: &Path) -> Result<(u64, usize)> {
-    let bytes = io::write_atomically(out, |w| {
-        map.save(w).with_context(|| format!("writing {}", out.display()))
-    })?;
-    Ok((bytes, map.memory_bytes()))
-}
-
 /// The patches or points of a map type of a synthetic scene.
 fn scene_source(
     name: &str,
@@ -384,7 +372,7 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
             if args.spacing.is_some() {
                 bail!("--spacing applies to patch inputs; a point cloud is used as it is");
             }
-            save(&AnyMap::PointCloud(PointCloudMap::from_points(points)?), &args.out)?
+            save_map(&AnyMap::PointCloud(PointCloudMap::from_points(points)?), &args.out)?
         }
         (Source::Points(_), backend) => bail!(
             "{label}: a point cloud has no patches; the {backend} backend needs a mesh or a patch \
@@ -398,23 +386,6 @@ fn build(args: &BuildArgs, progress: &Progress) -> Result<()> {
         args.backend
     ));
     Ok(())
-}
-
-/// Writes `patches` as a map file of `backend` (`spacing`: the sample spacing of a point-cloud
-/// map made from patches, which it needs); returns the bytes on disk and in memory.
-pub fn save_patches(
-    patches: Vec<Patch>,
-    backend: Backend,
-    spacing: Option<f64>,
-    out: &Path,
-) -> Result<(u64, usize)> {
-    let map = match AnyMap::from_patches(backend, patches, spacing) {
-        Err(AnyMapError::NeedsSpacing) => {
-            bail!("the pointcloud backend needs a point cloud, or --spacing to sample the patches")
-        }
-        map => map?,
-    };
-    save(&map, out)
 }
 
 /// `patchnav map compare`: the safety of TEST against TRUTH.
@@ -536,14 +507,6 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
     }
     print!("{out}");
     Ok(())
-}
-
-/// A box as `(x, y, z)..(x, y, z)` in centimetres' precision, for messages.
-pub(crate) fn box_text(b: &Aabb) -> String {
-    format!(
-        "({:.2}, {:.2}, {:.2})..({:.2}, {:.2}, {:.2})",
-        b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
-    )
 }
 
 /// Unsafe steps that touch one truth surface first.

@@ -84,7 +84,7 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
     let (Some(map_path), Some(start), Some(radius)) = (&args.map, args.start, args.radius) else {
         bail!("give a MAP with --start, --goal and --radius, or --problem");
     };
-    let map = crate::map::open_map(map_path)?;
+    let map = patch_pipeline::files::open_map(map_path)?;
     let bounds = map.bounds();
     if bounds.is_empty() {
         bail!("{}: the map is empty, so it has no bounds to sample in", map_path.display());

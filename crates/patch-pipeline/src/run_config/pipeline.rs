@@ -4,19 +4,20 @@
 //! [`DemoResults`].
 
 use super::config::{Config, Input, TerrainConfig, TofConfig};
-use crate::demo::model::{
+use crate::Progress;
+use crate::SensorPreset;
+use crate::demo::explore::{Exploration, Target, explore};
+use crate::demo::maps::{drawing, patch_mesh, point_map_entry};
+use crate::demo::planning::RunRecord;
+use crate::demo::{Clock, Files, p3, write_mesh_f32, write_ply_f32};
+use crate::input::CloudInput;
+use crate::results::{
     DemoResults, MapDrawing, MapRow, PlanRun, SceneInfo, TerrainSection, TimingCurve, TofSection,
     VolumeSection,
 };
-use crate::demo::pipeline::explore::{Exploration, Target, explore};
-use crate::demo::pipeline::maps::{drawing, patch_mesh, point_map_entry};
-use crate::demo::pipeline::planning::RunRecord;
-use crate::demo::pipeline::{Clock, Files, p3, write_mesh_f32, write_ply_f32};
-use crate::extract::SensorPreset;
-use crate::input::InputArgs;
-use crate::plan::make_planner;
-use crate::progress::Progress;
 use crate::scene_map::{MapKind, SceneSurfaces, Tessellation, patch_map};
+use crate::terrain::TerrainSetup;
+use crate::tof::{FilterSetup, FrameSource, Method, filter_frame};
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
 use patch_core::{CapsuleStep, Patch, Point3, UnspecificStepIntersector};
@@ -24,8 +25,6 @@ use patch_map::{
     AnyMap, Backend, MeshToPatchesConfig, PointCloudMap, planar_patches_from_mesh,
     sample_patch_points,
 };
-use patch_pipeline::terrain::TerrainSetup;
-use patch_pipeline::tof::{FilterSetup, FrameSource, Method, filter_frame};
 use pointcloud::{Aabb, PointCloud, SensorPose};
 use roadmap::{
     AnyOf, Goal, GoalReached, MaxIterations, PlannerKind, PlannerStatus, PlanningSpace, Problem,
@@ -34,7 +33,7 @@ use std::path::Path;
 use std::time::Instant;
 
 /// The backend each patch map is loaded into when `maps.backends` is not given: the parry BVH,
-/// as the demo plans on ([`crate::demo::pipeline::maps::plan_backend`]).
+/// as the demo plans on ([`crate::demo::maps::plan_backend`]).
 pub const DEFAULT_BACKEND: Backend = Backend::Trimesh;
 
 /// One map built, in one backend.
@@ -78,11 +77,11 @@ fn kind_of(map: &AnyMap) -> MapKind {
 }
 
 /// Reads the input.
-fn read(config: &Config, progress: &Progress) -> Result<Source> {
-    let options = InputArgs { skip_non_finite: config.skip_non_finite, depth_camera: None };
+fn read(config: &Config, progress: &dyn Progress) -> Result<Source> {
+    let options = CloudInput { skip_non_finite: config.skip_non_finite, depth: None };
     Ok(match &config.input {
         Input::Scans { files, poses } => {
-            let poses = poses.as_deref().map(crate::extract::read_poses).transpose()?;
+            let poses = poses.as_deref().map(crate::files::read_poses).transpose()?;
             let bar = progress.bar(files.len() as u64, "reading");
             let mut clouds = Vec::with_capacity(files.len());
             for path in files {
@@ -118,7 +117,7 @@ fn read(config: &Config, progress: &Progress) -> Result<Source> {
             }
             Source::Mesh(surfaces, mesh.bounds())
         }
-        Input::Map(path) => Source::Map(crate::map::open_map(path)?),
+        Input::Map(path) => Source::Map(crate::files::open_map(path)?),
         Input::Cloud(path) => {
             let cloud = crate::input::read_cloud(path, &options)?.to_world();
             if cloud.is_empty() {
@@ -162,13 +161,13 @@ impl Maps {
                 "the {kind} map has no patches (nothing was extracted); leave it out of maps.types"
             );
         }
-        let (planar, trimesh, triangles) = crate::demo::pipeline::maps::patch_counts(&patches)?;
+        let (planar, trimesh, triangles) = crate::demo::maps::patch_counts(&patches)?;
         for &backend in backends {
             let t0 = Instant::now();
             let map = patch_map(patches.clone(), backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
             let load = t0.elapsed().as_secs_f64();
-            self.rows.push(crate::demo::pipeline::maps::patch_map_row(
+            self.rows.push(crate::demo::maps::patch_map_row(
                 kind,
                 &map,
                 (planar, trimesh, triangles),
@@ -200,9 +199,8 @@ impl Maps {
     ) -> Result<()> {
         if let Some(patches) = map.patches() {
             let patches = patches.to_vec();
-            let counts = crate::demo::pipeline::maps::patch_counts(&patches)?;
-            self.rows
-                .push(crate::demo::pipeline::maps::patch_map_row(kind, &map, counts, seconds)?);
+            let counts = crate::demo::maps::patch_counts(&patches)?;
+            self.rows.push(crate::demo::maps::patch_map_row(kind, &map, counts, seconds)?);
             self.drawings.push(drawing(kind, &patches));
             if write_3d {
                 let name = format!("map-{kind}.ply");
@@ -247,7 +245,12 @@ fn mesh_tessellation(config: &Config, bounds: &Aabb) -> Tessellation {
 }
 
 /// Builds the configured map types from `source`.
-fn build(config: &Config, source: Source, progress: &Progress, files: &mut Files) -> Result<Maps> {
+fn build(
+    config: &Config,
+    source: Source,
+    progress: &dyn Progress,
+    files: &mut Files,
+) -> Result<Maps> {
     let mut maps = Maps { built: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
     let backends = config.backends.clone().unwrap_or_else(|| vec![DEFAULT_BACKEND]);
     let bar = progress.bar(config.types.len() as u64, "maps");
@@ -358,7 +361,7 @@ fn check_start(key: &str, start: &Point3, maps: &Maps, radius: f64) -> Result<()
     for m in &maps.built {
         let b = m.map.bounds();
         if !b.contains(start) {
-            bail!("{at} is outside the {} map's box {}", m.kind, crate::map::box_text(&b));
+            bail!("{at} is outside the {} map's box {}", m.kind, crate::files::box_text(&b));
         }
         if !CapsuleStep::sphere(*start, radius).is_ok_and(|s| m.map.is_step_free(&s)) {
             bail!(
@@ -377,7 +380,7 @@ fn check_start(key: &str, start: &Point3, maps: &Maps, radius: f64) -> Result<()
 fn timing_and_volume(
     config: &Config,
     maps: &Maps,
-    progress: &Progress,
+    progress: &dyn Progress,
 ) -> Result<(Vec<TimingCurve>, Option<VolumeSection>)> {
     let p = &config.plan;
     let targets: Vec<Target<'_>> =
@@ -420,7 +423,7 @@ fn timing_and_volume(
 fn plan(
     config: &Config,
     maps: &Maps,
-    progress: &Progress,
+    progress: &dyn Progress,
     files: &mut Files,
 ) -> Result<(Vec<PlanRun>, Vec<String>)> {
     let p = &config.plan;
@@ -445,7 +448,7 @@ fn plan(
                 continue;
             }
             for (k, &seed) in p.seeds.iter().enumerate() {
-                let mut run = make_planner(kind, &m.map, space, seed)?;
+                let mut run = roadmap::named_planner_on(kind, &m.map, space, seed)?;
                 let t0 = Instant::now();
                 let status =
                     run.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(p.max_iterations)));
@@ -508,7 +511,7 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
     let (frame, out, name) = filter_frame(&setup).context("[tof]")?;
     let millis = t0.elapsed().as_secs_f64() * 1e3;
     let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
-    let outcomes = crate::demo::pipeline::sensors::outcome_codes(&out.outcomes, &measured);
+    let outcomes = crate::demo::sensors::outcome_codes(&out.outcomes, &measured);
     if write_3d {
         let cloud = out.to_cloud(&frame, false);
         pointcloud::io::write_cloud(&out_path, &cloud)?;
@@ -545,7 +548,7 @@ fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
         max_range: t.max_range,
         ..TerrainSetup::new(t.frame.clone())
     };
-    let c = patch_pipeline::terrain::classify(&setup).context("[terrain]")?;
+    let c = crate::terrain::classify(&setup).context("[terrain]")?;
     let mut png = Vec::new();
     hough_png(
         c.classifier.accumulator(),
@@ -583,7 +586,7 @@ fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
 /// An input that cannot be read, a map type that cannot be built from it, a start that is not
 /// free, a planner refusing its map, a ToF or terrain frame that cannot be processed, or a file
 /// that cannot be written.
-pub fn run(config: &Config, progress: &Progress) -> Result<(DemoResults, Vec<String>)> {
+pub fn run(config: &Config, progress: &dyn Progress) -> Result<(DemoResults, Vec<String>)> {
     let out: &Path = &config.out;
     let mut files = Files::new(out);
     let mut clock = Clock::new();

@@ -2,16 +2,16 @@
 //! checked, paths resolved against the file's folder (the keys and their defaults are in the
 //! parent module's documentation).
 
-use crate::demo::model::Scale;
-use crate::demo::pipeline::Settings;
-use crate::demo::pipeline::explore::{EXPLORE_PLANNERS, MAX_VOLUME_MAPS};
-use crate::extract::SensorPreset;
+use crate::SensorPreset;
+use crate::demo::Settings;
+use crate::demo::explore::{EXPLORE_PLANNERS, MAX_VOLUME_MAPS};
 use crate::names::{self, NameParser, Named};
+use crate::results::Scale;
 use crate::scene_map::{MapKind, Tessellation};
+use crate::terrain::AxesChoice;
 use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};
 use patch_map::Backend;
-use patch_pipeline::terrain::AxesChoice;
 use roadmap::PlannerKind;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
