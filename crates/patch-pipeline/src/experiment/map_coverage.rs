@@ -259,25 +259,15 @@ mod tests {
     use super::*;
     use crate::scene_map::{ScanSetup, scan_clouds};
 
-    /// The shared real-data folder (never committed).
-    fn real_dir() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/real")
-    }
-
     /// Hybrid maps of organised real scans hold ≥ 99 % of their points (issue's contract); the
     /// data is read from the shared real-data folder and never committed.
     #[test]
     fn hybrid_maps_cover_organised_real_scans() {
-        let dir = real_dir();
-        if !dir.is_dir() {
-            println!("SKIPPED: {} not found", dir.display());
-            return;
-        }
+        // Missing data skips outside CI and fails in it (`shared_data`).
+        let Some(dir) = shared_data::real_data("") else { return };
         for s in SCANS.iter().filter(|s| s.file.contains("boxes") || s.file.contains("stereo")) {
-            let Some(r) = coverage_row(&dir, s.file, s.preset, s.depth_camera, 3.0).unwrap() else {
-                println!("SKIPPED: {} not found", s.file);
-                continue;
-            };
+            let r = coverage_row(&dir, s.file, s.preset, s.depth_camera, 3.0).unwrap();
+            let r = r.unwrap_or_else(|| panic!("{}: missing from {}", s.file, dir.display()));
             assert!(r.organised, "{}", s.file);
             assert!(
                 r.hybrid_coverage >= 0.99,
@@ -306,20 +296,11 @@ mod tests {
         assert!(r.hybrid_trimesh_patches > 0 && r.hybrid_coverage > r.planes_coverage, "{r:?}");
 
         let scan = "3dtk_kurt3d_scans/scan000.3d";
-        match coverage_row(&real_dir(), scan, SensorPreset::Alrf, None, 3.0).unwrap() {
-            Some(r) => {
-                assert!(!r.organised);
-                assert!(
-                    r.hybrid_coverage >= 0.99,
-                    "{scan}: hybrid covers {:.4}",
-                    r.hybrid_coverage
-                );
-                assert!(r.planes_coverage < r.hybrid_coverage, "{r:?}");
-            }
-            None => println!(
-                "SKIPPED (real data): {} not found; only the simulated scan was checked",
-                real_dir().join(scan).display()
-            ),
-        }
+        let Some(path) = shared_data::real_data(scan) else { return };
+        let dir = path.ancestors().nth(2).expect("the real-data folder");
+        let r = coverage_row(dir, scan, SensorPreset::Alrf, None, 3.0).unwrap().expect("found");
+        assert!(!r.organised);
+        assert!(r.hybrid_coverage >= 0.99, "{scan}: hybrid covers {:.4}", r.hybrid_coverage);
+        assert!(r.planes_coverage < r.hybrid_coverage, "{r:?}");
     }
 }
