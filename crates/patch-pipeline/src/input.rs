@@ -5,65 +5,27 @@ use anyhow::Result;
 use pointcloud::PointCloud;
 use pointcloud::io::depth_png::DepthCamera;
 use pointcloud::io::{self, Format, ReadOptions};
-use std::fmt;
 use std::path::Path;
-use std::str::FromStr;
 
-use crate::UnknownName;
+use crate::names::named_enum;
 
-/// The depth-image conventions a 16-bit PNG may follow.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum DepthConvention {
-    /// TUM RGB-D: fx = fy = 525, cx = 319.5, cy = 239.5, depth = value / 5000 m.
-    Tum,
-    /// OpenNI / PCL: fx = fy = 525, cx = 320, cy = 240, depth in millimetres.
-    Openni,
+named_enum! {
+    /// The depth-image conventions a 16-bit PNG may follow.
+    pub enum DepthConvention ("depth convention") {
+        /// TUM RGB-D: fx = fy = 525, cx = 319.5, cy = 239.5, depth = value / 5000 m.
+        Tum = "tum", "TUM RGB-D: fx = fy = 525, cx = 319.5, cy = 239.5, depth = value / 5000 m";
+        /// OpenNI / PCL: fx = fy = 525, cx = 320, cy = 240, depth in millimetres.
+        Openni = "openni", "OpenNI / PCL: fx = fy = 525, cx = 320, cy = 240, depth in millimetres";
+    }
 }
 
 impl DepthConvention {
-    /// Both.
-    pub const ALL: [DepthConvention; 2] = [DepthConvention::Tum, DepthConvention::Openni];
-
-    /// The lower-case name (`tum`, `openni`).
-    pub fn name(self) -> &'static str {
-        match self {
-            DepthConvention::Tum => "tum",
-            DepthConvention::Openni => "openni",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            DepthConvention::Tum => {
-                "TUM RGB-D: fx = fy = 525, cx = 319.5, cy = 239.5, depth = value / 5000 m"
-            }
-            DepthConvention::Openni => {
-                "OpenNI / PCL: fx = fy = 525, cx = 320, cy = 240, depth in millimetres"
-            }
-        }
-    }
-
     /// The camera model.
     pub fn camera(self) -> DepthCamera {
         match self {
             DepthConvention::Tum => DepthCamera::tum_kinect(),
             DepthConvention::Openni => DepthCamera::openni_mm(),
         }
-    }
-}
-
-impl fmt::Display for DepthConvention {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for DepthConvention {
-    type Err = UnknownName;
-
-    fn from_str(name: &str) -> Result<DepthConvention, UnknownName> {
-        UnknownName::find("depth convention", &DepthConvention::ALL, DepthConvention::name, name)
     }
 }
 

@@ -3,16 +3,74 @@
 //! by its own [`FromStr`]. [`NameParser`] accepts them, or a subset of them, and lists the
 //! accepted names; a program wraps it in its argument parser's value parser.
 
-use crate::experiment::extraction::RegionSource;
-use crate::input::DepthConvention;
-use crate::problem::Mode;
-use crate::terrain::AxesChoice;
-use crate::tof::Method;
-use crate::{MapKind, MapSource, SensorPreset};
 use patch_map::Backend;
 use roadmap::PlannerKind;
 use std::fmt;
 use std::str::FromStr;
+
+/// Defines an enum whose values have a name and a one-line description, with `ALL`, `name`,
+/// `description`, [`Display`](fmt::Display), [`FromStr`] (the error lists the names) and
+/// [`Named`]: one table per vocabulary.
+macro_rules! named_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $Enum:ident ($what:literal) {
+            $( $(#[$vmeta:meta])* $Variant:ident = $name:literal, $description:literal; )+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum $Enum {
+            $( $(#[$vmeta])* $Variant, )+
+        }
+
+        impl $Enum {
+            /// Every value, in the order help texts list them.
+            pub const ALL: [$Enum; [$(stringify!($Variant)),+].len()] = [$($Enum::$Variant),+];
+
+            /// The name on command lines and in configuration files.
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $( $Enum::$Variant => $name, )+
+                }
+            }
+
+            /// One line for help texts.
+            pub const fn description(self) -> &'static str {
+                match self {
+                    $( $Enum::$Variant => $description, )+
+                }
+            }
+        }
+
+        impl std::fmt::Display for $Enum {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl std::str::FromStr for $Enum {
+            type Err = $crate::UnknownName;
+
+            fn from_str(name: &str) -> Result<$Enum, $crate::UnknownName> {
+                $crate::UnknownName::find($what, &$Enum::ALL, $Enum::name, name)
+            }
+        }
+
+        impl $crate::names::Named for $Enum {
+            const ALL: &'static [$Enum] = &$Enum::ALL;
+
+            fn name(self) -> &'static str {
+                $Enum::name(self)
+            }
+
+            fn description(self) -> &'static str {
+                $Enum::description(self)
+            }
+        }
+    };
+}
+pub(crate) use named_enum;
 
 /// A library enum with a name and a description per value.
 pub trait Named: Copy + PartialEq + FromStr + Send + Sync + 'static {
@@ -33,102 +91,6 @@ impl Named for Backend {
 
     fn description(self) -> &'static str {
         Backend::description(self)
-    }
-}
-
-impl Named for MapKind {
-    const ALL: &'static [MapKind] = &MapKind::ALL;
-
-    fn name(self) -> &'static str {
-        MapKind::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        MapKind::description(self)
-    }
-}
-
-impl Named for MapSource {
-    const ALL: &'static [MapSource] = &MapSource::ALL;
-
-    fn name(self) -> &'static str {
-        MapSource::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        MapSource::description(self)
-    }
-}
-
-impl Named for DepthConvention {
-    const ALL: &'static [DepthConvention] = &DepthConvention::ALL;
-
-    fn name(self) -> &'static str {
-        DepthConvention::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        DepthConvention::description(self)
-    }
-}
-
-impl Named for SensorPreset {
-    const ALL: &'static [SensorPreset] = &SensorPreset::ALL;
-
-    fn name(self) -> &'static str {
-        SensorPreset::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        SensorPreset::description(self)
-    }
-}
-
-impl Named for RegionSource {
-    const ALL: &'static [RegionSource] = &RegionSource::ALL;
-
-    fn name(self) -> &'static str {
-        RegionSource::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        RegionSource::description(self)
-    }
-}
-
-impl Named for Mode {
-    const ALL: &'static [Mode] = &Mode::ALL;
-
-    fn name(self) -> &'static str {
-        Mode::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        Mode::description(self)
-    }
-}
-
-impl Named for AxesChoice {
-    const ALL: &'static [AxesChoice] = &AxesChoice::ALL;
-
-    fn name(self) -> &'static str {
-        AxesChoice::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        AxesChoice::description(self)
-    }
-}
-
-impl Named for Method {
-    const ALL: &'static [Method] = &Method::ALL;
-
-    fn name(self) -> &'static str {
-        Method::name(self)
-    }
-
-    fn description(self) -> &'static str {
-        Method::description(self)
     }
 }
 
@@ -232,5 +194,59 @@ impl<T: Named> NameParser<T> {
             }),
             Err(_) => Err(NameError::Unknown { given: text.to_owned(), choices: self.names() }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::extraction::RegionSource;
+    use crate::input::DepthConvention;
+    use crate::problem::Mode;
+    use crate::terrain::AxesChoice;
+    use crate::tof::Method;
+    use crate::{MapKind, MapSource, SensorPreset};
+
+    fn round_trips<T: Named + fmt::Display + fmt::Debug>()
+    where
+        <T as FromStr>::Err: fmt::Display,
+    {
+        let mut names: Vec<&str> = T::ALL.iter().map(|v| v.name()).collect();
+        for &v in T::ALL {
+            assert_eq!(v.name().parse::<T>().ok(), Some(v));
+            assert_eq!(v.to_string(), v.name());
+            assert!(!v.description().is_empty());
+        }
+        let e = match "no-such-name".parse::<T>() {
+            Err(e) => e.to_string(),
+            Ok(v) => panic!("parsed {v:?}"),
+        };
+        assert!(e.contains(&names.join(", ")), "{e}");
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), T::ALL.len(), "one name per value");
+    }
+
+    #[test]
+    fn every_vocabulary_parses_its_names_and_lists_them_when_it_cannot() {
+        round_trips::<Backend>();
+        round_trips::<PlannerKind>();
+        round_trips::<MapKind>();
+        round_trips::<MapSource>();
+        round_trips::<SensorPreset>();
+        round_trips::<DepthConvention>();
+        round_trips::<RegionSource>();
+        round_trips::<Mode>();
+        round_trips::<AxesChoice>();
+        round_trips::<Method>();
+    }
+
+    #[test]
+    fn a_subset_names_why_it_refuses_the_others() {
+        let p = patch_backends();
+        assert_eq!(p.parse("trimesh"), Ok(Backend::Trimesh));
+        assert!(matches!(p.parse("pointcloud"), Err(NameError::Refused { .. })));
+        assert!(matches!(p.parse("octree"), Err(NameError::Unknown { .. })));
+        assert!(!p.names().contains(&"pointcloud"));
     }
 }

@@ -18,51 +18,15 @@ use serde_json::{Value, json};
 use std::path::Path;
 use std::time::Instant;
 
-/// What the runs of a problem do.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Mode {
-    /// Exactly `iterations` iterations, no goal.
-    Explore,
-    /// One query per goal.
-    Solve,
-    /// All goals with one tree or roadmap.
-    Roi,
-}
-
-impl Mode {
-    /// The three modes.
-    pub const ALL: [Mode; 3] = [Mode::Explore, Mode::Solve, Mode::Roi];
-
-    /// The lower-case name (`explore`, `solve`, `roi`), as result rows spell it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Mode::Explore => "explore",
-            Mode::Solve => "solve",
-            Mode::Roi => "roi",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            Mode::Explore => "Exactly `iterations` iterations, no goal",
-            Mode::Solve => "One query per goal",
-            Mode::Roi => "All goals with one tree or roadmap",
-        }
-    }
-}
-
-impl std::fmt::Display for Mode {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Mode {
-    type Err = crate::UnknownName;
-
-    fn from_str(name: &str) -> Result<Mode, crate::UnknownName> {
-        crate::UnknownName::find("mode", &Mode::ALL, Mode::name, name)
+crate::names::named_enum! {
+    /// What the runs of a problem do.
+    pub enum Mode ("mode") {
+        /// Exactly `iterations` iterations, no goal.
+        Explore = "explore", "Exactly `iterations` iterations, no goal";
+        /// One query per goal.
+        Solve = "solve", "One query per goal";
+        /// All goals with one tree or roadmap.
+        Roi = "roi", "All goals with one tree or roadmap";
     }
 }
 

@@ -33,60 +33,20 @@ use pointcloud::{BeamModel, PointCloud};
 use scene_sim::{Alrf, AlrfConfig, RangeSensor, Scene};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::fmt;
-use std::str::FromStr;
 
-use crate::UnknownName;
+use crate::names::named_enum;
 
-/// The map types of the thesis's Table 6.1.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum MapKind {
-    /// Planar patches only.
-    Planes,
-    /// Planar patches plus the curved surfaces as trimesh patches.
-    Hybrid,
-    /// Every surface as a fine triangle mesh.
-    Trimesh,
-    /// Simulated ALRF scans as a point-cloud map.
-    Pc,
-}
-
-impl MapKind {
-    /// All four, in the thesis's order of discussion.
-    pub const ALL: [MapKind; 4] = [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh, MapKind::Pc];
-
-    /// The lower-case name (`planes`, `hybrid`, `trimesh`, `pc`).
-    pub fn name(self) -> &'static str {
-        match self {
-            MapKind::Planes => "planes",
-            MapKind::Hybrid => "hybrid",
-            MapKind::Trimesh => "trimesh",
-            MapKind::Pc => "pc",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            MapKind::Planes => "Planar patches only",
-            MapKind::Hybrid => "Planar patches plus the curved surfaces as trimesh patches",
-            MapKind::Trimesh => "Every surface as a fine triangle mesh",
-            MapKind::Pc => "Simulated ALRF scans as a point-cloud map",
-        }
-    }
-}
-
-impl FromStr for MapKind {
-    type Err = UnknownName;
-
-    fn from_str(name: &str) -> Result<MapKind, UnknownName> {
-        UnknownName::find("map kind", &MapKind::ALL, MapKind::name, name)
-    }
-}
-
-impl fmt::Display for MapKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+named_enum! {
+    /// The map types of the thesis's Table 6.1, in its order of discussion.
+    pub enum MapKind ("map kind") {
+        /// Planar patches only.
+        Planes = "planes", "Planar patches only";
+        /// Planar patches plus the curved surfaces as trimesh patches.
+        Hybrid = "hybrid", "Planar patches plus the curved surfaces as trimesh patches";
+        /// Every surface as a fine triangle mesh.
+        Trimesh = "trimesh", "Every surface as a fine triangle mesh";
+        /// Simulated ALRF scans as a point-cloud map.
+        Pc = "pc", "Simulated ALRF scans as a point-cloud map";
     }
 }
 
@@ -454,51 +414,17 @@ pub fn truth_patches(scene: &Scene) -> Result<Vec<Patch>> {
         .context("the exact hybrid map has patches")
 }
 
-/// Where the patches of the planes, hybrid and trimesh maps come from.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum MapSource {
-    /// The scene's exact geometry.
-    Scene,
-    /// Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1):
-    /// planes = planar patches merged across scans, hybrid = planes + trimesh patches grown on
-    /// each scan's remainder, trimesh = whole scans meshed by trimesh growing (Algorithms 4, 5).
-    Scans,
-}
-
-impl MapSource {
-    /// Both, the exact scene first.
-    pub const ALL: [MapSource; 2] = [MapSource::Scene, MapSource::Scans];
-
-    /// The lower-case name (`scene`, `scans`).
-    pub fn name(self) -> &'static str {
-        match self {
-            MapSource::Scene => "scene",
-            MapSource::Scans => "scans",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            MapSource::Scene => "The scene's exact geometry",
-            MapSource::Scans => {
-                "Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1)"
-            }
-        }
-    }
-}
-
-impl fmt::Display for MapSource {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for MapSource {
-    type Err = UnknownName;
-
-    fn from_str(name: &str) -> Result<MapSource, UnknownName> {
-        UnknownName::find("map source", &MapSource::ALL, MapSource::name, name)
+named_enum! {
+    /// Where the patches of the planes, hybrid and trimesh maps come from.
+    pub enum MapSource ("map source") {
+        /// The scene's exact geometry.
+        Scene = "scene", "The scene's exact geometry";
+        /// Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1):
+        /// planes = planar patches merged across scans, hybrid = planes + trimesh patches grown
+        /// on each scan's remainder, trimesh = whole scans meshed by trimesh growing
+        /// (Algorithms 4, 5).
+        Scans = "scans",
+            "Patch extraction from the simulated ALRF scans, as the thesis built its maps (§6.1)";
     }
 }
 

@@ -17,51 +17,14 @@ use pointcloud::Point3;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The sensor's axis convention.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum AxesChoice {
-    /// x forward, y left, z up (laser scanners such as KITTI's Velodyne, 3DTK scans).
-    Lidar,
-    /// z forward, x right, y down (range and stereo cameras, depth images).
-    Camera,
-}
-
-impl AxesChoice {
-    /// Both.
-    pub const ALL: [AxesChoice; 2] = [AxesChoice::Lidar, AxesChoice::Camera];
-
-    /// The lower-case name (`lidar`, `camera`).
-    pub fn name(self) -> &'static str {
-        match self {
-            AxesChoice::Lidar => "lidar",
-            AxesChoice::Camera => "camera",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            AxesChoice::Lidar => {
-                "x forward, y left, z up (laser scanners such as KITTI's Velodyne, 3DTK scans)"
-            }
-            AxesChoice::Camera => {
-                "z forward, x right, y down (range and stereo cameras, depth images)"
-            }
-        }
-    }
-}
-
-impl std::fmt::Display for AxesChoice {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for AxesChoice {
-    type Err = crate::UnknownName;
-
-    fn from_str(name: &str) -> Result<AxesChoice, crate::UnknownName> {
-        crate::UnknownName::find("axes", &AxesChoice::ALL, AxesChoice::name, name)
+crate::names::named_enum! {
+    /// The sensor's axis convention.
+    pub enum AxesChoice ("axes") {
+        /// x forward, y left, z up (laser scanners such as KITTI's Velodyne, 3DTK scans).
+        Lidar = "lidar",
+            "x forward, y left, z up (laser scanners such as KITTI's Velodyne, 3DTK scans)";
+        /// z forward, x right, y down (range and stereo cameras, depth images).
+        Camera = "camera", "z forward, x right, y down (range and stereo cameras, depth images)";
     }
 }
 

@@ -29,55 +29,17 @@ pub struct FrameSource {
     pub meta: PathBuf,
 }
 
-/// Which filter.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// The adaptive amplitude threshold (Eq 2.4) with the sidecar's illumination model.
-    Aat,
-    /// The plain amplitude threshold `--at`.
-    At,
-    /// Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`).
-    TwoFreq,
-}
-
-impl Method {
-    /// The three filters.
-    pub const ALL: [Method; 3] = [Method::Aat, Method::At, Method::TwoFreq];
-
-    /// The name on command lines (`aat`, `at`, `two-freq`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Aat => "aat",
-            Method::At => "at",
-            Method::TwoFreq => "two-freq",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            Method::Aat => {
-                "The adaptive amplitude threshold (Eq 2.4) with the sidecar's illumination model"
-            }
-            Method::At => "The plain amplitude threshold `--at`",
-            Method::TwoFreq => {
-                "Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`)"
-            }
-        }
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Method {
-    type Err = crate::UnknownName;
-
-    fn from_str(name: &str) -> Result<Method, crate::UnknownName> {
-        crate::UnknownName::find("method", &Method::ALL, Method::name, name)
+crate::names::named_enum! {
+    /// Which filter.
+    pub enum Method ("method") {
+        /// The adaptive amplitude threshold (Eq 2.4) with the sidecar's illumination model.
+        Aat = "aat",
+            "The adaptive amplitude threshold (Eq 2.4) with the sidecar's illumination model";
+        /// The plain amplitude threshold `--at`.
+        At = "at", "The plain amplitude threshold `--at`";
+        /// Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`).
+        TwoFreq = "two-freq",
+            "Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`)";
     }
 }
 

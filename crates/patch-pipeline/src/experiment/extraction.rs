@@ -108,49 +108,14 @@ const CAMERA_HEIGHT: Real = 1.0;
 /// The noise factors of the three levels.
 const NOISE_FACTORS: [Real; 3] = [0.0, 1.0, 2.0];
 
-/// Where the survey's regions come from.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum RegionSource {
-    /// Our plane segmentation's regions.
-    Segmented,
-    /// Scene-sim's ground-truth labels (simulated scans; real scans keep the segmentation).
-    Truth,
-}
-
-impl RegionSource {
-    /// Both.
-    pub const ALL: [RegionSource; 2] = [RegionSource::Segmented, RegionSource::Truth];
-
-    /// The lower-case name (`segmented`, `truth`).
-    pub fn name(self) -> &'static str {
-        match self {
-            RegionSource::Segmented => "segmented",
-            RegionSource::Truth => "truth",
-        }
-    }
-
-    /// One line for help texts.
-    pub fn description(self) -> &'static str {
-        match self {
-            RegionSource::Segmented => "Our plane segmentation's regions",
-            RegionSource::Truth => {
-                "Scene-sim's ground-truth labels (simulated scans; real scans keep the segmentation)"
-            }
-        }
-    }
-}
-
-impl std::fmt::Display for RegionSource {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for RegionSource {
-    type Err = crate::UnknownName;
-
-    fn from_str(name: &str) -> Result<RegionSource, crate::UnknownName> {
-        crate::UnknownName::find("region source", &RegionSource::ALL, RegionSource::name, name)
+crate::names::named_enum! {
+    /// Where the survey's regions come from.
+    pub enum RegionSource ("region source") {
+        /// Our plane segmentation's regions.
+        Segmented = "segmented", "Our plane segmentation's regions";
+        /// Scene-sim's ground-truth labels (simulated scans; real scans keep the segmentation).
+        Truth = "truth",
+            "Scene-sim's ground-truth labels (simulated scans; real scans keep the segmentation)";
     }
 }
 
