@@ -8,18 +8,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// The section headings of the page, in order.
-const HEADINGS: [&str; 10] = [
-    "1. The run",
-    "2. Map sizes",
-    "3. Is the map safe?",
-    "4. Planning",
-    "5. The maps",
-    "6. Explored volume",
-    "7. Time against iterations",
-    "8. Terrain",
-    "9. Time-of-flight frame",
-    "10. Files",
-];
+const HEADINGS: [&str; 10] = patch_pipeline::report::SECTIONS;
 
 const CHROMIUM: &str = "/usr/bin/chromium";
 
