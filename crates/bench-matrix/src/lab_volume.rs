@@ -51,11 +51,11 @@
 //! `starts`, `k`, `runs`, `radius`, the RRT's `step` or the PRM's `neighbours`, and `lab_maps`
 //! (the folder's name, which holds the build parameters).
 
-use crate::roadmap::lab_scene::near_corner;
 use crate::roadmap::{MatrixArgs, lab_maps};
 use anyhow::{Context, Result, bail};
-use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
+use patch_core::{Point3, Real};
 use patch_map::{AnyMap, Backend};
+use patch_pipeline::experiment::lab::{common_box, corner_starts};
 use pointcloud::Aabb;
 use roadmap::thesis;
 use roadmap::volume::{CongruenceTable, VoxelGrid, explored_part};
@@ -256,7 +256,7 @@ fn run_with(
     eprint!("{}", contents_table(&maps));
 
     let all: Vec<&AnyMap> = maps.iter().map(|m| &m.map).collect();
-    let common = lab_maps::common_box(maps.iter().map(|m| m.bounds));
+    let common = common_box(maps.iter().map(|m| m.bounds));
     let starts = corner_starts(&all, &common, RADIUS, room, config.starts)?;
     let empty = VoxelGrid::covering(maps.iter().map(|m| m.bounds), config.cells)
         .context("the voxel grid over the maps")?;
@@ -356,40 +356,6 @@ fn load_maps(folder: &Path) -> Result<Vec<LabMap>> {
 fn scans_of_build(folder: &Path) -> Option<u64> {
     let text = std::fs::read_to_string(folder.join("build.json")).ok()?;
     serde_json::from_str::<Value>(&text).ok()?.get("scans")?.as_u64()
-}
-
-/// The first `n` (1–4) RRT starts: for each room corner in the order south-west, south-east,
-/// north-east, north-west (the room spans `(0, 0)`–`room`), the first point free on every map
-/// (a sphere of `radius`) and inside `within` on a small spiral from 0.6 m inside the corner,
-/// at 1.0 m height — the rule of the matrix's lab scenes (whose start is the first of these)
-/// and of `patchnav experiment lab-volume`.
-///
-/// # Errors
-/// No free point near a corner.
-pub(crate) fn corner_starts(
-    maps: &[&AnyMap],
-    within: &Aabb,
-    radius: Real,
-    room: [Real; 2],
-    n: usize,
-) -> Result<Vec<Point3>> {
-    let [lx, ly] = room;
-    let corners =
-        [(0.0, 0.0, 1.0, 1.0), (lx, 0.0, -1.0, 1.0), (lx, ly, -1.0, -1.0), (0.0, ly, 1.0, -1.0)];
-    let free = |p: &Point3| {
-        within.contains(p)
-            && maps
-                .iter()
-                .all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.is_step_free(&s)))
-    };
-    corners
-        .iter()
-        .take(n)
-        .map(|&(cx, cy, sx, sy)| {
-            near_corner(Point3::new(cx, cy, 1.0), [sx, sy], free)
-                .with_context(|| format!("no free start near the room corner ({cx}, {cy})"))
-        })
-        .collect()
 }
 
 /// One roadmap to grow: on map `map`, planner `PLANNERS[planner]`.
@@ -608,6 +574,7 @@ fn contents_table(maps: &[LabMap]) -> String {
 mod tests {
     use super::*;
     use crate::roadmap::lab_maps::tests::{TempDir, write_tiny_maps};
+    use patch_core::{CapsuleStep, UnspecificStepIntersector as _};
     use std::collections::{HashMap, HashSet};
 
     fn args(seeds: u64, jobs: usize) -> MatrixArgs {
@@ -694,7 +661,7 @@ mod tests {
         let loaded = lab_maps::load(&dir.0, RADIUS).unwrap();
         let maps = load_maps(&dir.0).unwrap();
         let all: Vec<&AnyMap> = maps.iter().map(|m| &m.map).collect();
-        let common = lab_maps::common_box(maps.iter().map(|m| m.bounds));
+        let common = common_box(maps.iter().map(|m| m.bounds));
         let starts = corner_starts(&all, &common, RADIUS, [4.0, 4.0], 4).unwrap();
         assert_eq!(starts.len(), 4);
         assert_eq!(starts[0], loaded.start, "the matrix's lab-scans start");

@@ -55,6 +55,8 @@ mod planners;
 use anyhow::{Context, Result, bail};
 use patch_core::{Patch, Point3, Real};
 use patch_map::{AnyMap, Backend, MeshToPatchesConfig, planar_patches_from_mesh};
+use patch_pipeline::experiment::lab::{LAB_ROOM, corner_starts};
+use pointcloud::Aabb;
 use roadmap::metrics::{added_length, turn_angles, upper_quartile};
 use roadmap::{
     AnyOf, GoalReached, MaxIterations, PathMetrics, PlannerKind, PlannerStatus, PlanningSpace,
@@ -488,8 +490,11 @@ fn lab_setup(backends: &[Backend]) -> Result<Setup> {
     let bounds = scene.bounds();
     let space =
         PlanningSpace::new(bounds, LAB_RADIUS, LAB_STEP).context("the lab's planning space")?;
-    let start =
-        lab_scene::corner_start(&maps.iter().map(|m| &m.1).collect::<Vec<_>>(), LAB_RADIUS, None)?;
+    let on: Vec<&AnyMap> = maps.iter().map(|m| &m.1).collect();
+    let anywhere =
+        Aabb::new(Point3::from([Real::NEG_INFINITY; 3]), Point3::from([Real::INFINITY; 3]));
+    let start = corner_starts(&on, &anywhere, LAB_RADIUS, LAB_ROOM, 1)
+        .context("no free start near the lab's south-west corner")?[0];
     Ok(Setup {
         scene: "lab",
         lab_maps: None,

@@ -9,12 +9,13 @@
 //! the raw clouds, L6576–6582). Every map samples in its own box (thesis L6460, as
 //! `patchnav experiment lab-timing`): the box of its patches or points. The start is the
 //! experiment's first corner start: the first point of the south-west spiral that is free on
-//! all four maps and inside the box common to them ([`lab_scene::corner_start`]).
+//! all four maps and inside the box common to them
+//! ([`patch_pipeline::experiment::lab::corner_starts`]).
 
-use super::lab_scene;
 use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};
 use patch_map::{AnyMap, Backend, load_any};
+use patch_pipeline::experiment::lab::{LAB_ROOM, common_box, corner_starts};
 use pointcloud::Aabb;
 use std::fs::File;
 use std::io::BufReader;
@@ -55,18 +56,6 @@ pub(crate) struct LabMaps {
     bounds: Vec<(&'static str, Aabb)>,
     /// The RRT's start: free on all four maps.
     pub start: Point3,
-}
-
-/// The box common to all of `boxes` (their intersection; a box that misses another shrinks
-/// to a flat or point box at the larger min corner, so it stays well formed); the empty box
-/// for none.
-pub(crate) fn common_box(boxes: impl IntoIterator<Item = Aabb>) -> Aabb {
-    let mut boxes = boxes.into_iter();
-    let Some(first) = boxes.next() else { return Aabb::EMPTY };
-    boxes.fold(first, |a, b| {
-        let (min, max) = (a.min.sup(&b.min), a.max.inf(&b.max));
-        Aabb::new(min, max.sup(&min))
-    })
 }
 
 /// The path of the map file of `kind` in `folder`: `<kind>.pmap`.
@@ -114,8 +103,8 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
     }
     let common = common_box(bounds.iter().map(|(_, b)| *b));
     let all: Vec<&AnyMap> = maps.iter().filter_map(|(_, m)| m.as_ref()).collect();
-    let start = lab_scene::corner_start(&all, radius, Some(&common))
-        .with_context(|| format!("the maps of {}", folder.display()))?;
+    let start = corner_starts(&all, &common, radius, LAB_ROOM, 1)
+        .with_context(|| format!("the maps of {}", folder.display()))?[0];
     Ok(LabMaps { folder: folder.to_owned(), maps, bounds, start })
 }
 

@@ -6,7 +6,7 @@ use super::explore::{Exploration, Target, explore};
 use super::maps::Built;
 use super::{Files, GOAL_TOLERANCE, MAX_DRAWN, RADIUS, STEP, Settings, decimate, p3, p3mm};
 use crate::Progress;
-use crate::experiment::lab::{common_box, corner_starts};
+use crate::experiment::lab::{LAB_ROOM, common_box_of, corner_starts};
 use crate::polylines::{write_obj_paths, write_obj_roadmap};
 use crate::results::{PlanRun, TimingCurve, VolumeSection};
 use crate::scene_map::{BuiltMap, MapKind};
@@ -51,7 +51,8 @@ fn planner(
 /// The first point free on every map near each of the four room corners, 1 m up (the lab
 /// experiments' starts).
 pub fn starts(built: &Built) -> Result<Vec<Point3>> {
-    corner_starts(&built.maps, &common_box(&built.maps), RADIUS, 4)
+    let on: Vec<&AnyMap> = built.maps.iter().map(|m| &m.map).collect();
+    corner_starts(&on, &common_box_of(&built.maps), RADIUS, LAB_ROOM, 4)
 }
 
 /// The demo's planning problem: from the south-west corner start to the south-east and
@@ -61,7 +62,7 @@ pub fn starts(built: &Built) -> Result<Vec<Point3>> {
 pub fn plan_points(built: &Built, starts: &[Point3]) -> Result<(Point3, Vec<Point3>)> {
     let (start, corners) = starts.split_first().context("no start")?;
     let mut goals: Vec<Point3> = corners.iter().take(2).copied().collect();
-    let common = common_box(&built.maps);
+    let common = common_box_of(&built.maps);
     let free = |p: &Point3| {
         common.contains(p)
             && built.maps.iter().all(|m| {

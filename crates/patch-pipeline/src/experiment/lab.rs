@@ -194,17 +194,26 @@ struct Lab {
     build_seconds: Vec<f64>,
 }
 
-/// The box common to all maps.
-pub fn common_box(maps: &[BuiltMap]) -> Aabb {
-    let boxes: Vec<Aabb> = maps.iter().map(|m| m.map.bounds()).collect();
-    let min = boxes.iter().fold(boxes[0].min, |a, b| a.sup(&b.min));
-    let max = boxes.iter().fold(boxes[0].max, |a, b| a.inf(&b.max));
-    Aabb::new(min, max.sup(&min))
+/// The box common to all of `boxes` (their intersection; a box that misses another shrinks
+/// to a flat or point box at the larger min corner, so it stays well formed); the empty box
+/// for none.
+pub fn common_box(boxes: impl IntoIterator<Item = Aabb>) -> Aabb {
+    let mut boxes = boxes.into_iter();
+    let Some(first) = boxes.next() else { return Aabb::EMPTY };
+    boxes.fold(first, |a, b| {
+        let (min, max) = (a.min.sup(&b.min), a.max.inf(&b.max));
+        Aabb::new(min, max.sup(&min))
+    })
+}
+
+/// The box common to the maps' boxes ([`common_box`]).
+pub fn common_box_of(maps: &[BuiltMap]) -> Aabb {
+    common_box(maps.iter().map(|m| m.map.bounds()))
 }
 
 impl Lab {
     fn space(&self, map: &BuiltMap, args: &LabSetup) -> Result<PlanningSpace> {
-        let bounds = if args.common_box { common_box(&self.maps) } else { map.map.bounds() };
+        let bounds = if args.common_box { common_box_of(&self.maps) } else { map.map.bounds() };
         PlanningSpace::new(bounds, args.radius, args.step)
             .context("--radius and --step must be positive numbers of metres")
     }
@@ -248,45 +257,69 @@ fn build_lab(args: &LabSetup, progress: &dyn Progress) -> Result<Lab> {
         spinner.finish_and_clear();
         maps.push(map);
     }
-    let starts = corner_starts(&maps, &common_box(&maps), args.radius, args.starts as usize)?;
+    let on: Vec<&AnyMap> = maps.iter().map(|m| &m.map).collect();
+    let starts =
+        corner_starts(&on, &common_box_of(&maps), args.radius, LAB_ROOM, args.starts as usize)?;
     Ok(Lab { maps, starts, build_seconds })
 }
 
-/// The first point where a sphere of `radius` is free on every map (and inside every map's
-/// box) on a spiral of candidates from 0.6 m inside each room corner at 1.0 m height; `count`
-/// of them (at most 4), the corners in the order south-west, south-east, north-east,
-/// north-west.
+/// The lab's floor, metres: the room spans `(0, 0)`–`LAB_ROOM` ([`scene_sim::lab_layout::ROOM`]).
+pub const LAB_ROOM: [Real; 2] = [scene_sim::lab_layout::ROOM[0], scene_sim::lab_layout::ROOM[1]];
+
+/// The first `n` (1–4) RRT starts: for each room corner in the order south-west, south-east,
+/// north-east, north-west (the room spans `(0, 0)`–`room`), the first point free on every map
+/// (a sphere of `radius`) and inside `within` on a small spiral from 0.6 m inside the corner
+/// ([`near_corner`]), at 1.0 m height. The rule of the lab experiments, the demo and the
+/// benchmark matrix's lab scenes.
+///
+/// # Errors
+/// No free point near a corner.
 pub fn corner_starts(
-    maps: &[BuiltMap],
-    common: &Aabb,
+    maps: &[&AnyMap],
+    within: &Aabb,
     radius: Real,
-    count: usize,
+    room: [Real; 2],
+    n: usize,
 ) -> Result<Vec<Point3>> {
-    let [lx, ly, _] = scene_sim::lab_layout::ROOM;
+    let [lx, ly] = room;
     let corners =
         [(0.0, 0.0, 1.0, 1.0), (lx, 0.0, -1.0, 1.0), (lx, ly, -1.0, -1.0), (0.0, ly, 1.0, -1.0)];
     let free = |p: &Point3| {
-        common.contains(p)
+        within.contains(p)
             && maps
                 .iter()
-                .all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.map.is_step_free(&s)))
+                .all(|m| CapsuleStep::sphere(*p, radius).is_ok_and(|s| m.is_step_free(&s)))
     };
-    let mut starts = Vec::new();
-    for &(cx, cy, sx, sy) in corners.iter().take(count) {
-        let found = (0..8).flat_map(|ring| {
+    corners
+        .iter()
+        .take(n)
+        .map(|&(cx, cy, sx, sy)| {
+            near_corner(Point3::new(cx, cy, 1.0), [sx, sy], free)
+                .with_context(|| format!("no free start near the room corner ({cx}, {cy})"))
+        })
+        .collect()
+}
+
+/// The first point `free` accepts on a small spiral from 0.6 m inside a room corner at
+/// `corner` (its height kept), stepping 0.2 m into the room along `inwards` (±1 per axis),
+/// eight rings.
+pub fn near_corner(
+    corner: Point3,
+    inwards: [Real; 2],
+    free: impl Fn(&Point3) -> bool,
+) -> Option<Point3> {
+    (0..8)
+        .flat_map(|ring| {
             let d = 0.6 + 0.2 * Real::from(ring);
             (0..=ring).flat_map(move |k| {
                 let e = 0.6 + 0.2 * Real::from(k);
                 [(d, e), (e, d)]
             })
-        });
-        let p = found
-            .map(|(dx, dy)| Point3::new(cx + sx * dx, cy + sy * dy, 1.0))
-            .find(|p| free(p))
-            .with_context(|| format!("no free start near the corner ({cx}, {cy})"))?;
-        starts.push(p);
-    }
-    Ok(starts)
+        })
+        .map(|(dx, dy)| {
+            Point3::new(corner.x + inwards[0] * dx, corner.y + inwards[1] * dy, corner.z)
+        })
+        .find(|p| free(p))
 }
 
 /// Prints our Table 6.1 analogue beside the thesis's.
@@ -351,7 +384,7 @@ fn table_6_1(lab: &Lab, args: &LabSetup) -> Result<String> {
     let starts: Vec<String> =
         lab.starts.iter().map(|p| format!("({:.1}, {:.1}, {:.1})", p.x, p.y, p.z)).collect();
     writeln!(out, "starts: {}", starts.join(", "))?;
-    let b = common_box(&lab.maps);
+    let b = common_box_of(&lab.maps);
     // Rounding leaves −1e-16 where the walls are at 0: print it as 0.
     let c = |x: Real| if x.abs() < 5e-3 { 0.0 } else { x };
     writeln!(
