@@ -784,7 +784,14 @@ impl VoxelGrid {
         if ry * ry + rz * rz > cap.r2 + cap.margin {
             return None;
         }
-        let x_closest = cap.a.x + t_min * d.x;
+        let x_closest = if cap.dyz > 0.0 {
+            cap.a.x + t_min * d.x
+        } else {
+            // A segment along x is equally close to the row everywhere: take its point nearest
+            // the grid's middle, so the fallback below looks inside the grid.
+            let mid = self.min.x + 0.5 * self.cell * Real::from(self.n);
+            mid.clamp(cap.a.x.min(cap.b.x), cap.a.x.max(cap.b.x))
+        };
         let row = RowTerms::new(cap, ey, ez, y - cap.b.y, z - cap.b.z);
 
         // The analytic interval: end spheres and the cylinder part.
