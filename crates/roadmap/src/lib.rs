@@ -54,8 +54,8 @@
 //! * RRT step: `x_new = x_near + min(max_step, |x − x_near|)·unit` (§7.8; the thesis says both
 //!   "fixed distance" and "maximum length").
 //! * Direct goal test of the Lesum variants: one capsule of any length from the new vertex to
-//!   the goal centre (§7.17), optional ([`RrtConfig::direct_goal_step`],
-//!   [`PrmConfig::direct_goal_step`]).
+//!   the goal centre (§7.17), optional ([`GoalStep::Direct`] in
+//!   [`RrtConfig::goal_step`] and [`PrmConfig::goal_step`]).
 //! * Goal-directed sampling: `σ = sqrt(d_far[mm]·factor)` mm per axis, redrawn outside the
 //!   box (§7.9; [`Sampler::GoalGaussian`]).
 //! * PRM components by union–find; no vertex validity check, no edge-length limit by default
@@ -77,7 +77,7 @@
 //!   apart from the collision checks.
 //! * Path metrics (§5.5.4, Tables 5.5–5.11): the thesis does not define its quartile; see
 //!   [`metrics`] for the method used and the treatment of straight and repeated vertices.
-//! * PRM* (Karaman & Frazzoli 2011, k-nearest variant; [`PrmConfig::star`]): the PRM loop
+//! * PRM* (Karaman & Frazzoli 2011, k-nearest variant; [`PrmConnections::Star`]): the PRM loop
 //!   with `k(n) = ⌈e·(1 + 1/3)·ln n⌉` neighbours for the `n`-th vertex
 //!   ([`PrmConfig::neighbours_for`]) and without the component test, so its roadmap has
 //!   cycles; paths of every planner are shortest by length in the roadmap (Dijkstra), which
@@ -173,8 +173,8 @@ pub use named::{
     named_planner_on,
 };
 pub use nn::{KdNeighbors, LinearNeighbors, NearestNeighbors, Neighbor};
-pub use planner::{Planner, PlannerCounters, PlannerStatus, Roadmap};
-pub use prm::{LazyPrm, Prm, PrmConfig};
+pub use planner::{GoalStep, Planner, PlannerCounters, PlannerStatus, Roadmap};
+pub use prm::{LazyPrm, Prm, PrmConfig, PrmConnections, PrmEdges, PrmSamples};
 #[cfg(feature = "problem-file")]
 pub use problem_file::{MAX_ITERATIONS, ProblemFile, ProblemFileError};
 pub use rrt::{Rrt, RrtConfig, Sampler};

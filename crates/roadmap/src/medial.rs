@@ -271,9 +271,7 @@ impl<M: ProximityQuery + UnspecificStepIntersector + ?Sized> Planner for MaPrm<'
             counter.retract(&planner::uniform(rng, space), &bounds, tolerance)
         };
         let solution = &mut self.solution;
-        let lazy = false;
-        let status =
-            solve_prm(map, space, &config.prm, lazy, self.seed, problem, stop, solution, sample);
+        let status = solve_prm(map, space, &config.prm, self.seed, problem, stop, solution, sample);
         counter.finish(solution);
         status
     }

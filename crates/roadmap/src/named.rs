@@ -22,6 +22,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::GoalStep;
 use crate::{
     EvasionRrt, EvasionRrtConfig, MaPrm, MaPrmConfig, MaRrt, MaRrtConfig, Planner, PlanningSpace,
     Prm, PrmConfig, Rrt, RrtConfig, RrtConnect, RrtStar, RrtStarConfig,
@@ -241,7 +242,7 @@ impl FromStr for PlannerKind {
 
 /// PRM with the thesis's six neighbours and the direct goal step.
 fn prm_config() -> PrmConfig {
-    PrmConfig { direct_goal_step: true, ..PrmConfig::thesis() }
+    PrmConfig { goal_step: GoalStep::Direct, ..PrmConfig::thesis() }
 }
 
 /// The planner `kind` on any map that tests steps.
@@ -349,12 +350,12 @@ where
         PlannerKind::Rrt => Box::new(Rrt::new(map, space, RrtConfig::lesum(None), seed)),
         PlannerKind::Prm => Box::new(Prm::new(map, space, prm_config(), seed)),
         PlannerKind::PrmStar => {
-            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::star() };
+            let config = PrmConfig { goal_step: GoalStep::Direct, ..PrmConfig::star() };
             Box::new(Prm::new(map, space, config, seed))
         }
         PlannerKind::LazyPrm => Box::new(Prm::lazy(map, space, prm_config(), seed)),
         PlannerKind::PrmValid => {
-            let config = PrmConfig { direct_goal_step: true, ..PrmConfig::valid() };
+            let config = PrmConfig { goal_step: GoalStep::Direct, ..PrmConfig::valid() };
             Box::new(Prm::new(map, space, config, seed))
         }
         PlannerKind::RrtStar => {

@@ -15,6 +15,17 @@ use crate::termination::{Progress, Termination};
 /// the robot radius was found free; its weight is its length.
 pub type Roadmap = UnGraph<Point3, Real>;
 
+/// Whether a tree or roadmap planner also tests the straight step to each unreached goal.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum GoalStep {
+    /// Goals are reached only by vertices the planner grows there (thesis Algorithms 13, 14).
+    Grown,
+    /// After each added vertex, also test the straight capsule step from it to each unreached
+    /// goal centre, of any length (spec §7.17), and on success add the centre as a vertex (the
+    /// thesis's Lesum variants, §6.2.3).
+    Direct,
+}
+
 /// How a `solve` ended: an outcome, not an error (OMPL's `PlannerStatus`).
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub enum PlannerStatus {

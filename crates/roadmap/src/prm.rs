@@ -12,40 +12,67 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
+use crate::planner::{self, Checker, GoalStep, Planner, PlannerStatus, Solution};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
+
+/// How a new PRM vertex connects to its nearest vertices.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum PrmConnections {
+    /// Algorithm 14: the `N` nearest, skipping those already in the vertex's component, so
+    /// the roadmap is a forest and paths follow the first connection found.
+    Forest,
+    /// All of the `N` nearest, also those already in the component, so the roadmap gets
+    /// cycles and [`Planner::path_to`] returns the shortest path by length in it (OMPL's PRM
+    /// connects this way). Not in the thesis.
+    Cycles,
+    /// PRM* (Karaman & Frazzoli 2011, the k-nearest variant; not in the thesis): the
+    /// `k(n) = ⌈e·(1 + 1/3)·ln n⌉` nearest (3D; [`PrmConfig::neighbours_for`]) instead of
+    /// `N`, with cycles.
+    Star,
+}
+
+/// Which samples become PRM vertices.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum PrmSamples {
+    /// Every sample (Algorithm 14, spec §4): a colliding one stays an isolated vertex that
+    /// later samples waste neighbour slots on.
+    All,
+    /// Each sample's sphere is checked first and a colliding one dropped (the iteration still
+    /// counts; one capsule check of zero length). OMPL's PRM samples valid states only.
+    Valid,
+}
+
+/// When the PRM checks its edges.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum PrmEdges {
+    /// Each edge when it is added (Algorithm 14).
+    Eager,
+    /// Only the edges of candidate paths, when a goal is sought (lazy PRM, Bohlin & Kavraki
+    /// 2000; [`LazyPrm`]).
+    Lazy,
+}
 
 /// The choices of a [`Prm`]. No `Default`: pick [`PrmConfig::thesis`] and change fields.
 #[derive(Copy, Clone, Debug, PartialEq)]
 pub struct PrmConfig {
     /// How many nearest existing vertices a new sample tries to connect to (the thesis's `N`,
     /// not given there; spec §7.4 recommends at least 6, Fig. 6.9). Ignored with
-    /// [`star`](Self::star).
+    /// [`PrmConnections::Star`].
     pub neighbours: usize,
     /// Only vertices within this distance are tried; `None`: no edge-length limit, as in the
     /// thesis (§5.5, §6.1). A non-finite or negative radius connects nothing.
     pub connection_radius: Option<Real>,
-    /// After each added vertex, if an unreached goal has no vertex yet, also test the straight
-    /// capsule step from the vertex to the goal centre and on success add the centre as a
-    /// vertex (the direct goal test of the thesis's Lesum variants, §6.2.3, carried over).
-    pub direct_goal_step: bool,
-    /// PRM* (Karaman & Frazzoli 2011, the k-nearest variant; not in the thesis): a sample
-    /// added as the `n`-th vertex tries its `k(n) = ⌈e·(1 + 1/3)·ln n⌉` nearest existing
-    /// vertices (3D; [`PrmConfig::neighbours_for`]) instead of [`neighbours`](Self::neighbours),
-    /// and also connects to neighbours already in its component, so the roadmap has cycles and
-    /// paths are shortest by length in it. `false`: Algorithm 14's forest.
-    pub star: bool,
-    /// Check each sample's sphere before adding it and drop a colliding one (the iteration
-    /// still counts; one capsule check of zero length). Not in the thesis: Algorithm 14 adds
-    /// every sample, and a colliding one stays an isolated vertex that later samples waste
-    /// neighbour slots on (spec §4). OMPL's PRM samples valid states only.
-    pub valid_samples: bool,
-    /// Try every one of the `N` neighbours, also those already in the sample's component, so
-    /// the roadmap gets cycles and [`Planner::path_to`] returns the shortest path by length
-    /// in it (OMPL's PRM connects this way). `false`: Algorithm 14's forest, whose paths
-    /// follow the first connection found and are longer. Implied by [`star`](Self::star).
-    pub cycles: bool,
+    /// Whether each added vertex also tries the straight step to each unreached goal without
+    /// a vertex ([`GoalStep::Direct`]: the direct goal test of the thesis's Lesum variants,
+    /// §6.2.3, carried over).
+    pub goal_step: GoalStep,
+    /// How a new vertex connects to its neighbours.
+    pub connections: PrmConnections,
+    /// Which samples become vertices.
+    pub samples: PrmSamples,
+    /// When edges are checked.
+    pub edges: PrmEdges,
 }
 
 impl PrmConfig {
@@ -55,32 +82,35 @@ impl PrmConfig {
         PrmConfig {
             neighbours: 6,
             connection_radius: None,
-            direct_goal_step: false,
-            star: false,
-            valid_samples: false,
-            cycles: false,
+            goal_step: GoalStep::Grown,
+            connections: PrmConnections::Forest,
+            samples: PrmSamples::All,
+            edges: PrmEdges::Eager,
         }
     }
 
     /// Algorithm 14 with the two changes a roadmap for path quality wants (not in the
-    /// thesis): samples checked before they are added ([`valid_samples`](Self::valid_samples))
-    /// and edges to all `N = 6` neighbours ([`cycles`](Self::cycles)), as OMPL's PRM builds
-    /// its roadmap.
+    /// thesis): samples checked before they are added ([`PrmSamples::Valid`]) and edges to
+    /// all `N = 6` neighbours ([`PrmConnections::Cycles`]), as OMPL's PRM builds its roadmap.
     pub fn valid() -> PrmConfig {
-        PrmConfig { valid_samples: true, cycles: true, ..PrmConfig::thesis() }
+        PrmConfig {
+            samples: PrmSamples::Valid,
+            connections: PrmConnections::Cycles,
+            ..PrmConfig::thesis()
+        }
     }
 
-    /// PRM* (Karaman & Frazzoli 2011, k-nearest variant): [`star`](Self::star) set, no
+    /// PRM* (Karaman & Frazzoli 2011, k-nearest variant): [`PrmConnections::Star`], no
     /// edge-length limit, no direct goal test.
     pub fn star() -> PrmConfig {
-        PrmConfig { star: true, ..PrmConfig::thesis() }
+        PrmConfig { connections: PrmConnections::Star, ..PrmConfig::thesis() }
     }
 
     /// How many nearest existing vertices a sample tries when it becomes the `vertices`-th
     /// vertex (counting itself and the start): [`neighbours`](Self::neighbours), or with
-    /// [`star`](Self::star) `k(n) = ⌈e·(1 + 1/3)·ln n⌉` (0 for `n ≤ 1`).
+    /// [`PrmConnections::Star`] `k(n) = ⌈e·(1 + 1/3)·ln n⌉` (0 for `n ≤ 1`).
     pub fn neighbours_for(&self, vertices: usize) -> usize {
-        if !self.star {
+        if self.connections != PrmConnections::Star {
             return self.neighbours;
         }
         if vertices <= 1 {
@@ -103,7 +133,7 @@ impl PrmConfig {
 /// sample stays isolated, because every capsule from it includes its sphere. The roadmap is a
 /// forest by construction. [`PlanningSpace::max_step`] is not used.
 ///
-/// With [`PrmConfig::star`] (PRM*, [`PrmConfig::star()`]) `N` grows with the vertex count
+/// With [`PrmConnections::Star`] (PRM*, [`PrmConfig::star()`]) `N` grows with the vertex count
 /// ([`PrmConfig::neighbours_for`]) and the component test is dropped, so every free edge to
 /// the `k(n)` nearest vertices is added and the roadmap has cycles; [`Planner::path_to`]
 /// returns the shortest path by length in the roadmap.
@@ -120,26 +150,24 @@ pub struct Prm<'m, M: UnspecificStepIntersector + ?Sized> {
     space: PlanningSpace,
     config: PrmConfig,
     seed: u64,
-    /// The lazy PRM ([`LazyPrm`]) instead of the eager one.
-    lazy: bool,
     solution: Solution,
 }
 
 impl<'m, M: UnspecificStepIntersector + ?Sized> Prm<'m, M> {
     /// A planner on `map` in `space`; `seed` fixes the random stream.
     pub fn new(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> Self {
-        Prm { map, space, config, seed, lazy: false, solution: Solution::default() }
+        Prm { map, space, config, seed, solution: Solution::default() }
     }
 
-    /// The lazy PRM (see [`LazyPrm`]) on `map` in `space`; with the same seed its samples are
-    /// those of [`Prm::new`].
+    /// The lazy PRM (see [`LazyPrm`]) on `map` in `space`: `config` with
+    /// [`PrmEdges::Lazy`]; with the same seed its samples are those of [`Prm::new`].
     pub fn lazy(map: &'m M, space: PlanningSpace, config: PrmConfig, seed: u64) -> LazyPrm<'m, M> {
-        Prm { map, space, config, seed, lazy: true, solution: Solution::default() }
+        Prm::new(map, space, PrmConfig { edges: PrmEdges::Lazy, ..config }, seed)
     }
 
     /// Whether this is the lazy PRM.
     pub fn is_lazy(&self) -> bool {
-        self.lazy
+        self.config.edges == PrmEdges::Lazy
     }
 
     /// The configuration.
@@ -158,12 +186,15 @@ impl<M: UnspecificStepIntersector + ?Sized> Planner for Prm<'_, M> {
     /// `lazy-prm-star`, which has none.
     fn name(&self) -> &'static str {
         use crate::PlannerKind as K;
-        match (self.lazy, self.config.star, self.config.valid_samples || self.config.cycles) {
-            (false, false, false) => K::Prm.name(),
-            (false, false, true) => K::PrmValid.name(),
-            (false, true, _) => K::PrmStar.name(),
-            (true, false, _) => K::LazyPrm.name(),
-            (true, true, _) => "lazy-prm-star",
+        let c = &self.config;
+        let star = c.connections == PrmConnections::Star;
+        let valid = c.samples == PrmSamples::Valid || c.connections == PrmConnections::Cycles;
+        match (c.edges, star, valid) {
+            (PrmEdges::Eager, false, false) => K::Prm.name(),
+            (PrmEdges::Eager, false, true) => K::PrmValid.name(),
+            (PrmEdges::Eager, true, _) => K::PrmStar.name(),
+            (PrmEdges::Lazy, false, _) => K::LazyPrm.name(),
+            (PrmEdges::Lazy, true, _) => "lazy-prm-star",
         }
     }
 
@@ -171,8 +202,7 @@ impl<M: UnspecificStepIntersector + ?Sized> Planner for Prm<'_, M> {
         let space = &self.space;
         let sample = |rng: &mut ChaCha8Rng| Some(planner::uniform(rng, space));
         let solution = &mut self.solution;
-        let lazy = self.lazy;
-        solve_prm(self.map, space, &self.config, lazy, self.seed, problem, stop, solution, sample)
+        solve_prm(self.map, space, &self.config, self.seed, problem, stop, solution, sample)
     }
 
     planner::solution_accessors!();
@@ -184,7 +214,7 @@ impl<M: UnspecificStepIntersector + ?Sized> Planner for Prm<'_, M> {
 /// share everything but the edge checks).
 ///
 /// Each iteration draws a uniform sample, adds it, and joins it by *unchecked* edges to its
-/// `N` nearest existing vertices ([`PrmConfig::neighbours`]; with [`PrmConfig::star`] the
+/// `N` nearest existing vertices ([`PrmConfig::neighbours`]; with [`PrmConnections::Star`] the
 /// `k(n)` of PRM*), within [`PrmConfig::connection_radius`]. There is no component test:
 /// unchecked edges are optimistic, and a forest of them would lose a connection for good when
 /// one of its edges turns out to collide (Bohlin & Kavraki likewise connect to all
@@ -215,7 +245,7 @@ impl<M: UnspecificStepIntersector + ?Sized> Planner for Prm<'_, M> {
 /// exact again, and the query is repeated only once new edges join the start's optimistic
 /// component to the goal again.
 ///
-/// The direct goal step ([`PrmConfig::direct_goal_step`]) stays eager: its capsule is checked
+/// The direct goal step ([`PrmConfig::goal_step`]) stays eager: its capsule is checked
 /// at once, as in the [`Prm`].
 ///
 /// [`Planner::roadmap`] holds every vertex but only the edges checked free (the roadmap's
@@ -403,7 +433,7 @@ impl Ord for Queued {
     }
 }
 
-/// The PRM loop shared by [`Prm`], [`LazyPrm`] (`lazy`) and the MA PRM: `sample(rng)` gives
+/// The PRM loop shared by [`Prm`], [`LazyPrm`] ([`PrmEdges::Lazy`]) and the MA PRM: `sample(rng)` gives
 /// the next vertex, or `None` to drop the iteration's sample (it still counts as an
 /// iteration).
 #[allow(clippy::too_many_arguments)]
@@ -411,7 +441,6 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector + ?Sized>(
     map: &M,
     space: &PlanningSpace,
     config: &PrmConfig,
-    lazy: bool,
     seed: u64,
     problem: &Problem,
     stop: &mut dyn Termination,
@@ -419,6 +448,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector + ?Sized>(
     mut sample: impl FnMut(&mut ChaCha8Rng) -> Option<Point3>,
 ) -> PlannerStatus {
     let started = Instant::now();
+    let lazy = config.edges == PrmEdges::Lazy;
     solution.reset(&problem.goals);
     let mut checker = Checker::new(map, space.robot_radius());
     if let Some(invalid) = planner::validate(problem, space, &mut checker) {
@@ -448,7 +478,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector + ?Sized>(
         let Some(x) = sample(&mut rng) else {
             continue;
         };
-        if config.valid_samples && !checker.free(&x, &x) {
+        if config.samples == PrmSamples::Valid && !checker.free(&x, &x) {
             continue;
         }
         let k = config.neighbours_for(solution.graph.node_count() + 1);
@@ -458,8 +488,7 @@ pub(crate) fn solve_prm<M: UnspecificStepIntersector + ?Sized>(
             let w = NodeIndex::new(n.index);
             if lazy {
                 forest.connect_lazily(solution, w, v);
-            } else if (config.star
-                || config.cycles
+            } else if (config.connections != PrmConnections::Forest
                 || !forest.components.equiv(v.index(), w.index()))
                 && checker.free(&solution.graph[w], &x)
             {
@@ -492,7 +521,7 @@ fn direct_goal_steps<M: UnspecificStepIntersector + ?Sized>(
     config: &PrmConfig,
     v: NodeIndex,
 ) {
-    if !config.direct_goal_step {
+    if config.goal_step == GoalStep::Grown {
         return;
     }
     for g in 0..solution.goals.len() {

@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerStatus, Solution};
+use crate::planner::{self, Checker, GoalStep, Planner, PlannerStatus, Solution};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
 
@@ -42,17 +42,16 @@ pub struct RrtConfig {
     pub goal_bias: Real,
     /// Where the other samples come from.
     pub sampler: Sampler,
-    /// After each added vertex, also test the straight capsule step from it to each
-    /// unreached goal centre, of any length (spec §7.17), and on success add the centre as a
-    /// vertex (the thesis's Lesum variants, §6.2.3).
-    pub direct_goal_step: bool,
+    /// Whether each added vertex also tries the straight step to the unreached goals
+    /// ([`GoalStep::Direct`]: the thesis's Lesum variants, §6.2.3).
+    pub goal_step: GoalStep,
 }
 
 impl RrtConfig {
     /// Algorithm 13 as run for the thesis's roadmaps (§6.1): uniform samples, no goal bias,
     /// no direct goal test.
     pub fn thesis() -> RrtConfig {
-        RrtConfig { goal_bias: 0.0, sampler: Sampler::Uniform, direct_goal_step: false }
+        RrtConfig { goal_bias: 0.0, sampler: Sampler::Uniform, goal_step: GoalStep::Grown }
     }
 
     /// The Lesum variant (§6.2.3): the direct goal test after each vertex, and goal-directed
@@ -61,7 +60,7 @@ impl RrtConfig {
     pub fn lesum(bias_factor: Option<Real>) -> RrtConfig {
         let sampler =
             bias_factor.map_or(Sampler::Uniform, |factor| Sampler::GoalGaussian { factor });
-        RrtConfig { goal_bias: 0.0, sampler, direct_goal_step: true }
+        RrtConfig { goal_bias: 0.0, sampler, goal_step: GoalStep::Direct }
     }
 }
 
@@ -73,7 +72,7 @@ impl RrtConfig {
 /// becomes a vertex with an edge to `x_near`; otherwise the iteration adds nothing (Trapped).
 /// A sample equal to `x_near` adds nothing either. After each added vertex every unreached
 /// goal is tested: it is reached if the vertex lies within its tolerance, or (with
-/// [`RrtConfig::direct_goal_step`]) if the capsule from the vertex to the goal centre is free.
+/// [`RrtConfig::goal_step`]) if the capsule from the vertex to the goal centre is free.
 ///
 /// Needs only [`UnspecificStepIntersector`] (thesis Table 5.2).
 ///
@@ -198,7 +197,7 @@ fn test_goals<M: UnspecificStepIntersector + ?Sized>(
         let distance = (goal.center - p).norm();
         if distance <= goal.tolerance {
             solution.reached[g] = Some(v);
-        } else if config.direct_goal_step && checker.free(&p, &goal.center) {
+        } else if config.goal_step == GoalStep::Direct && checker.free(&p, &goal.center) {
             let w = solution.graph.add_node(goal.center);
             solution.graph.add_edge(v, w, distance);
             nn.add(goal.center);

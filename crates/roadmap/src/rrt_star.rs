@@ -10,7 +10,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::nn::{KdNeighbors, NearestNeighbors};
-use crate::planner::{self, Checker, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution};
+use crate::planner::{
+    self, Checker, GoalStep, Planner, PlannerCounters, PlannerStatus, Roadmap, Solution,
+};
 use crate::rrt::{self, RrtConfig};
 use crate::space::{PlanningSpace, Problem};
 use crate::termination::Termination;
@@ -374,7 +376,7 @@ fn direct_goal_steps<M: UnspecificStepIntersector + ?Sized>(
     config: &RrtStarConfig,
     v: NodeIndex,
 ) {
-    if !config.rrt.direct_goal_step {
+    if config.rrt.goal_step == GoalStep::Grown {
         return;
     }
     for g in 0..solution.goals.len() {

@@ -103,7 +103,7 @@ const fn t(steep: u32, total: u32, ratio: f64) -> Option<Turns> {
 
 use PlannerKind::{EvasionRrt, MaPrm, MaRrt, Prm, Rrt};
 
-/// Table 5.3 (L6154–6166): median wall time [s] to reach the four ROIs from the start.
+/// Table 5.3 (L6154–6166): median wall time \[s\] to reach the four ROIs from the start.
 pub const TABLE_5_3: OfficeTable<f64> = OfficeTable {
     number: "5.3",
     caption: "median wall time taken to reach the ROIs from the starting point [s]",
@@ -133,7 +133,7 @@ pub const TABLE_5_4: OfficeTable<QuartileRatios> = OfficeTable {
     ],
 };
 
-/// Table 5.5 (L6220–6232): median added length [m] of the paths from the start to all ROIs
+/// Table 5.5 (L6220–6232): median added length \[m\] of the paths from the start to all ROIs
 /// (the sum of the four paths' lengths).
 pub const TABLE_5_5: OfficeTable<f64> = OfficeTable {
     number: "5.5",
@@ -370,7 +370,7 @@ pub const TABLE_6_4_PRM: [VolumeRow; 4] = [
     },
 ];
 
-/// Fig 6.4 (L6813–6818), RRT on the lab at K = 500: "less then [sic] 0.4 seconds" on the
+/// Fig 6.4 (L6813–6818), RRT on the lab at K = 500: "less then \[sic\] 0.4 seconds" on the
 /// planes and hybrid maps, s (an upper bound; the figure's values are not printed).
 pub const FIG_6_4_PATCH_MAPS_BELOW_S: f64 = 0.4;
 

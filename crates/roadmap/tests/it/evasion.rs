@@ -11,8 +11,8 @@ use petgraph::algo::is_cyclic_undirected;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::{
-    EvasionRrt, EvasionRrtConfig, Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace,
-    Problem, Roadmap, Rrt, RrtConfig,
+    EvasionRrt, EvasionRrtConfig, Goal, GoalStep, MaxIterations, Planner, PlannerStatus,
+    PlanningSpace, Problem, Roadmap, Rrt, RrtConfig,
 };
 
 use crate::common;
@@ -163,7 +163,7 @@ fn counters_count_specific_checks() {
     for direct in [false, true] {
         counted.reset_counts();
         let mut cfg = config(&space(0.5));
-        cfg.rrt.direct_goal_step = direct;
+        cfg.rrt.goal_step = if direct { GoalStep::Direct } else { GoalStep::Grown };
         let mut p = EvasionRrt::new(&counted, space(0.5), cfg, 2);
         p.solve(&problem, &mut MaxIterations(300));
         let c = p.counters();

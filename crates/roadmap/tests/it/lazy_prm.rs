@@ -8,7 +8,7 @@ use patch_core::{
 };
 use proptest::prelude::*;
 use roadmap::{
-    Goal, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
+    Goal, GoalStep, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,
 };
 
 use crate::common;
@@ -130,7 +130,8 @@ proptest! {
         let goals: Vec<Goal> = goals.into_iter().map(|center| Goal { center, tolerance: 0.25 }).collect();
         let problem = Problem { start, goals: goals.clone() };
         let base = if star { PrmConfig::star() } else { PrmConfig::thesis() };
-        let config = PrmConfig { direct_goal_step, ..base };
+        let goal_step = if direct_goal_step { GoalStep::Direct } else { GoalStep::Grown };
+        let config = PrmConfig { goal_step, ..base };
         let mut p = Prm::lazy(&map, space, config, seed);
         let status = p.solve(&problem, &mut MaxIterations(80));
         assert_all_free(&map, &p, goals.len());

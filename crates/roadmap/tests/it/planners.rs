@@ -10,8 +10,8 @@ use petgraph::algo::is_cyclic_undirected;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig,
-    Problem, Roadmap, Rrt, RrtConfig, Sampler, Termination,
+    AnyOf, Goal, GoalReached, GoalStep, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm,
+    PrmConfig, Problem, Roadmap, Rrt, RrtConfig, Sampler, Termination,
 };
 
 use crate::common;
@@ -74,7 +74,7 @@ fn lesum_rrt_steps_straight_to_a_visible_goal() {
     assert_all_free(&map, &rrt, 1);
 
     let mut config = PrmConfig::thesis();
-    config.direct_goal_step = true;
+    config.goal_step = GoalStep::Direct;
     let mut prm = Prm::new(&map, space(0.5), config, 4);
     assert_eq!(prm.solve(&problem, &mut until_solved(20_000)), PlannerStatus::Exact);
     assert_all_free(&map, &prm, 1);
@@ -288,7 +288,8 @@ proptest! {
             prop_assert!(graph.node_weights().all(|p| space.bounds().contains(p)));
         }
 
-        let prm_config = PrmConfig { neighbours: 5, connection_radius: radius_limit, direct_goal_step: lesum, star: false, valid_samples: false, cycles: false };
+        let goal_step = if lesum { GoalStep::Direct } else { GoalStep::Grown };
+        let prm_config = PrmConfig { neighbours: 5, connection_radius: radius_limit, goal_step, ..PrmConfig::thesis() };
         let mut prm = Prm::new(&map, space, prm_config, seed);
         let status = prm.solve(&problem, &mut MaxIterations(60));
         assert_all_free(&map, &prm, 1);
@@ -304,7 +305,7 @@ proptest! {
             let within = prm
                 .roadmap()
                 .edge_references()
-                .all(|e| *e.weight() <= r || prm_config.direct_goal_step);
+                .all(|e| *e.weight() <= r || prm_config.goal_step == GoalStep::Direct);
             prop_assert!(within, "PRM edge longer than the connection radius");
         }
     }

@@ -8,8 +8,8 @@ use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 use roadmap::metrics::path_length;
 use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm, PrmConfig,
-    Problem,
+    AnyOf, Goal, GoalReached, GoalStep, MaxIterations, Planner, PlannerStatus, PlanningSpace, Prm,
+    PrmConfig, PrmConnections, Problem,
 };
 
 use crate::common;
@@ -32,7 +32,7 @@ fn assert_edges_free(map: &BruteForceMap, prm: &dyn Planner) {
 #[test]
 fn the_neighbour_count_follows_the_formula() {
     let star = PrmConfig::star();
-    assert!(star.star);
+    assert_eq!(star.connections, PrmConnections::Star);
     let formula = |n: usize| (std::f64::consts::E * (4.0 / 3.0) * (n as Real).ln()).ceil() as usize;
     for n in 2..5_000 {
         assert_eq!(star.neighbours_for(n), formula(n), "n = {n}");
@@ -43,7 +43,7 @@ fn the_neighbour_count_follows_the_formula() {
     assert_eq!(star.neighbours_for(1), 0);
     // Without `star` the count is the fixed `N`.
     let thesis = PrmConfig::thesis();
-    assert!(!thesis.star);
+    assert_eq!(thesis.connections, PrmConnections::Forest);
     assert!([1, 2, 100, 10_000].iter().all(|&n| thesis.neighbours_for(n) == 6));
 }
 
@@ -111,7 +111,8 @@ proptest! {
         let map = BruteForceMap::from_patches(patches).unwrap();
         let space = PlanningSpace::new(strategies::scene_bounds(), RADIUS, 0.8).unwrap();
         let problem = Problem { start, goals: vec![Goal { center: goal, tolerance: 0.25 }] };
-        let config = PrmConfig { direct_goal_step, ..PrmConfig::star() };
+        let goal_step = if direct_goal_step { GoalStep::Direct } else { GoalStep::Grown };
+        let config = PrmConfig { goal_step, ..PrmConfig::star() };
         let mut prm = Prm::new(&map, space, config, seed);
         let status = prm.solve(&problem, &mut MaxIterations(80));
         assert_edges_free(&map, &prm);

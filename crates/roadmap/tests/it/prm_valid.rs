@@ -4,7 +4,7 @@
 
 use patch_core::{BruteForceMap, CapsuleStep, Counted, UnspecificStepIntersector};
 use petgraph::algo::is_cyclic_undirected;
-use roadmap::{MaxIterations, PathMetrics, Planner, PlannerStatus, Prm, PrmConfig};
+use roadmap::{MaxIterations, PathMetrics, Planner, PlannerStatus, Prm, PrmConfig, PrmConnections};
 
 use crate::common;
 use common::*;
@@ -46,7 +46,7 @@ fn cycles_alone_shorten_paths_on_the_same_samples() {
     let mut longer = 0;
     for seed in 0..6 {
         let mut forest = Prm::new(&map, space(0.5), PrmConfig::thesis(), seed);
-        let cycles = PrmConfig { cycles: true, ..PrmConfig::thesis() };
+        let cycles = PrmConfig { connections: PrmConnections::Cycles, ..PrmConfig::thesis() };
         let mut with_cycles = Prm::new(&map, space(0.5), cycles, seed);
         forest.solve(&problem, &mut MaxIterations(800));
         with_cycles.solve(&problem, &mut MaxIterations(800));
