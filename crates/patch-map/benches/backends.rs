@@ -28,9 +28,10 @@ use patch_core::{
     Aabb, CapsuleStep, FromPatches, Isometry3, LineStep, Patch, PlanarPatch, Point2, Point3,
     Polygon, Real, SpecificStepIntersector, UnspecificStepIntersector, Vector3, na,
 };
+#[cfg(feature = "rapier")]
+use patch_map::RapierMap;
 use patch_map::{
-    BBox6dMap, Backend as BackendName, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
-    sample_patch_points,
+    BBox6dMap, Backend as BackendName, PointCloudMap, PolygonMap, TrimeshMap, sample_patch_points,
 };
 
 /// The robot radius.
@@ -45,6 +46,7 @@ fn backends(c: &mut Criterion, scene: &Scene) {
     bench_backend::<PolygonMap>(c, scene, BackendName::Polygon.name());
     bench_backend::<BBox6dMap>(c, scene, BackendName::BBox6d.name());
     bench_backend::<TrimeshMap>(c, scene, BackendName::Trimesh.name());
+    #[cfg(feature = "rapier")]
     bench_backend::<RapierMap>(c, scene, BackendName::Rapier.name());
     bench_point_cloud(c, scene);
 }

@@ -8,11 +8,13 @@ use patch_core::{
     PatchMapVisitor, Real, UnspecificStepIntersector,
 };
 
+#[cfg(feature = "rapier")]
+use crate::RapierMap;
 use crate::mapfile::{MapCounts, MapFileError};
 use crate::persist::{MapFile, MemoryUsage};
 use crate::{
-    BBox6dMap, Backend, MeshMapError, PointCloudMap, PointCloudMapError, PolygonMap, RapierMap,
-    SamplingError, TrimeshMap, sample_patch_points,
+    BBox6dMap, Backend, MeshMapError, PointCloudMap, PointCloudMapError, PolygonMap, SamplingError,
+    TrimeshMap, sample_patch_points,
 };
 
 /// A map of any backend of this crate.
@@ -30,7 +32,8 @@ pub enum AnyMap {
     PointCloud(PointCloudMap),
     /// A [`TrimeshMap`] (tag `trimesh`).
     Trimesh(TrimeshMap),
-    /// A [`RapierMap`] (tag `rapier`).
+    /// A [`RapierMap`] (tag `rapier`; feature `rapier`).
+    #[cfg(feature = "rapier")]
     Rapier(RapierMap),
 }
 
@@ -54,6 +57,12 @@ pub enum AnyMapError {
     /// The point-cloud backend refused the sampled points.
     #[error(transparent)]
     Points(#[from] PointCloudMapError),
+    /// The backend is left out of this build (its cargo feature is off).
+    #[error("the `{backend}` backend is not in this build (enable the `{backend}` feature)")]
+    NotBuilt {
+        /// The backend asked for.
+        backend: Backend,
+    },
 }
 
 impl AnyMap {
@@ -73,7 +82,10 @@ impl AnyMap {
             Backend::Polygon => AnyMap::Polygon(PolygonMap::from_patches(patches)?),
             Backend::BBox6d => AnyMap::BBox6d(BBox6dMap::from_patches(patches)?),
             Backend::Trimesh => AnyMap::Trimesh(TrimeshMap::from_patches(patches)?),
+            #[cfg(feature = "rapier")]
             Backend::Rapier => AnyMap::Rapier(RapierMap::from_patches(patches)?),
+            #[cfg(not(feature = "rapier"))]
+            Backend::Rapier => return Err(AnyMapError::NotBuilt { backend }),
             Backend::PointCloud => {
                 let spacing = point_spacing.ok_or(AnyMapError::NeedsSpacing)?;
                 let points = sample_patch_points(&patches, spacing)?;
@@ -89,6 +101,7 @@ impl AnyMap {
             AnyMap::BBox6d(_) => BBox6dMap::BACKEND,
             AnyMap::PointCloud(_) => PointCloudMap::BACKEND,
             AnyMap::Trimesh(_) => TrimeshMap::BACKEND,
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(_) => RapierMap::BACKEND,
         }
     }
@@ -100,6 +113,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => m.memory_bytes(),
             AnyMap::PointCloud(m) => MemoryUsage::memory_bytes(m),
             AnyMap::Trimesh(m) => m.memory_bytes(),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => MemoryUsage::memory_bytes(m),
         }
     }
@@ -111,6 +125,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => m.counts(),
             AnyMap::PointCloud(m) => m.counts(),
             AnyMap::Trimesh(m) => m.counts(),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => m.counts(),
         }
     }
@@ -125,6 +140,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => m.save(writer),
             AnyMap::PointCloud(m) => m.save(writer),
             AnyMap::Trimesh(m) => m.save(writer),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => m.save(writer),
         }
     }
@@ -136,6 +152,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => m.bounds(),
             AnyMap::PointCloud(m) => m.bounds(),
             AnyMap::Trimesh(m) => m.bounds(),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => m.bounds(),
         }
     }
@@ -148,6 +165,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => Some(m.tolerance()),
             AnyMap::PointCloud(_) => None,
             AnyMap::Trimesh(m) => Some(m.tolerance()),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => Some(m.tolerance()),
         }
     }
@@ -159,6 +177,7 @@ impl AnyMap {
             AnyMap::BBox6d(m) => Some(m.patches()),
             AnyMap::PointCloud(_) => None,
             AnyMap::Trimesh(m) => Some(m.patches()),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => Some(m.patches()),
         }
     }
@@ -172,6 +191,7 @@ impl MaybePatchMap for AnyMap {
             AnyMap::Polygon(m) => Ok(visitor.visit(m)),
             AnyMap::BBox6d(m) => Ok(visitor.visit(m)),
             AnyMap::Trimesh(m) => Ok(visitor.visit(m)),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => Ok(visitor.visit(m)),
             AnyMap::PointCloud(_) => Err(visitor),
         }
@@ -191,6 +211,7 @@ impl UnspecificStepIntersector for AnyMap {
             AnyMap::BBox6d(m) => m.is_step_free(step),
             AnyMap::PointCloud(m) => m.is_step_free(step),
             AnyMap::Trimesh(m) => m.is_step_free(step),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => m.is_step_free(step),
         }
     }
@@ -204,6 +225,7 @@ impl UnspecificStepIntersector<LineStep> for AnyMap {
             AnyMap::BBox6d(m) => m.is_step_free(step),
             AnyMap::PointCloud(m) => m.is_step_free(step),
             AnyMap::Trimesh(m) => m.is_step_free(step),
+            #[cfg(feature = "rapier")]
             AnyMap::Rapier(m) => m.is_step_free(step),
         }
     }
@@ -230,6 +252,12 @@ mod tests {
     #[test]
     fn every_backend_builds_and_its_files_carry_its_name() {
         for backend in Backend::ALL {
+            if !backend.is_built() {
+                let e = AnyMap::from_patches(backend, square(), Some(0.1)).unwrap_err();
+                assert!(matches!(e, AnyMapError::NotBuilt { .. }), "{e}");
+                assert!(e.to_string().contains("feature"), "{e}");
+                continue;
+            }
             let map = AnyMap::from_patches(backend, square(), Some(0.1)).unwrap();
             assert_eq!(map.backend(), backend);
             assert_eq!(map.backend_name(), backend.name());
@@ -252,6 +280,6 @@ mod tests {
         let e = AnyMap::from_patches(Backend::PointCloud, square(), Some(-1.0)).unwrap_err();
         assert!(matches!(e, AnyMapError::Sampling(SamplingError::BadSpacing(_))), "{e}");
         // The patch backends need no spacing.
-        assert!(AnyMap::from_patches(Backend::Rapier, square(), None).is_ok());
+        assert!(AnyMap::from_patches(Backend::Trimesh, square(), None).is_ok());
     }
 }

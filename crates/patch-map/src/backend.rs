@@ -72,6 +72,12 @@ impl Backend {
         !matches!(self, Backend::PointCloud)
     }
 
+    /// Whether this build has the backend: all but `rapier`, which needs the `rapier` feature
+    /// (on by default).
+    pub const fn is_built(self) -> bool {
+        !matches!(self, Backend::Rapier) || cfg!(feature = "rapier")
+    }
+
     /// The backends that hold patches, in [`ALL`](Self::ALL) order.
     pub fn patch_backends() -> impl Iterator<Item = Backend> {
         Backend::ALL.into_iter().filter(|b| b.holds_patches())

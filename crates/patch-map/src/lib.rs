@@ -18,6 +18,8 @@
 //!   parry's own GJK and shape casts miss rare contacts (measured; see [`trimesh`]).
 //! * [`RapierMap`] — the thesis's set-up with Bullet's collision world: one collider per patch
 //!   in a rapier query pipeline (a dynamic broad phase), the same narrow phase as [`TrimeshMap`].
+//!   Behind the default feature `rapier`; without it, asking for the backend is
+//!   [`AnyMapError::NotBuilt`].
 //! * [`PointCloudMap`] — the thesis's PointCloudMap (L5584–5784): no patches at all; the scan
 //!   points in k-d trees and Algorithm 10 for capsule steps ([`point_cloud`]).
 //!
@@ -88,6 +90,7 @@ pub mod mapfile;
 pub mod persist;
 pub mod point_cloud;
 pub mod polygon;
+#[cfg(feature = "rapier")]
 pub mod rapier;
 pub mod sampling;
 /// Constrained Delaunay triangulation of polygons with holes; it lives in `patch-core`, which
@@ -110,5 +113,6 @@ pub use compare::{
 };
 pub use persist::{MapFile, MemoryUsage, load_any};
 pub use polygon::PolygonMap;
+#[cfg(feature = "rapier")]
 pub use rapier::RapierMap;
 pub use trimesh::{MeshMapError, TrimeshMap};

@@ -23,9 +23,11 @@ use std::io::{Read, Write};
 
 use patch_core::{FromPatches, Patch, PatchMap, Point3, Real};
 
+#[cfg(feature = "rapier")]
+use crate::RapierMap;
 pub use crate::any_map::AnyMap;
 use crate::mapfile::{HEADER_LEN, MapCounts, MapFileError, read_header, read_map, write_map};
-use crate::{BBox6dMap, Backend, PointCloudMap, PolygonMap, RapierMap, TrimeshMap};
+use crate::{BBox6dMap, Backend, PointCloudMap, PolygonMap, TrimeshMap};
 
 /// A map that can be written to and read from a map file ([`mapfile`](crate::mapfile)).
 pub trait MapFile: Sized {
@@ -199,7 +201,10 @@ pub fn load_any(mut reader: impl Read) -> Result<AnyMap, MapFileError> {
         Backend::BBox6d => BBox6dMap::load(whole).map(AnyMap::BBox6d),
         Backend::PointCloud => PointCloudMap::load(whole).map(AnyMap::PointCloud),
         Backend::Trimesh => TrimeshMap::load(whole).map(AnyMap::Trimesh),
+        #[cfg(feature = "rapier")]
         Backend::Rapier => RapierMap::load(whole).map(AnyMap::Rapier),
+        #[cfg(not(feature = "rapier"))]
+        Backend::Rapier => Err(MapFileError::UnknownBackend { found: backend.name().to_owned() }),
     }
 }
 

@@ -9,9 +9,9 @@ use patch_core::{
     Counted, FromPatches, LineStep, PatchMap, PatchMapMut, ProximityQuery, SpecificStepIntersector,
     UnspecificStepIntersector,
 };
-use patch_map::{
-    AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap, RapierMap, TrimeshMap,
-};
+#[cfg(feature = "rapier")]
+use patch_map::RapierMap;
+use patch_map::{AnyMap, BBox6dMap, MapFile, MemoryUsage, PointCloudMap, PolygonMap, TrimeshMap};
 
 fn assert_patch_map<T: PatchMap>() {}
 fn assert_patch_map_mut<T: PatchMapMut>() {}
@@ -82,9 +82,12 @@ fn positive_table() {
     assert_map_file::<TrimeshMap>();
     assert_memory_usage::<TrimeshMap>();
     assert_send_sync::<TrimeshMap>();
-    assert_full::<RapierMap>();
-    assert_map_file::<RapierMap>();
-    assert_memory_usage::<RapierMap>();
+    #[cfg(feature = "rapier")]
+    {
+        assert_full::<RapierMap>();
+        assert_map_file::<RapierMap>();
+        assert_memory_usage::<RapierMap>();
+    }
 }
 
 /// `implements!(T: Trait)`: whether the concrete type `T` implements `Trait`, as a `bool`
@@ -146,7 +149,10 @@ fn full_table() {
     assert_map_file::<TrimeshMap>();
     assert_memory_usage::<TrimeshMap>();
     assert_send_sync::<TrimeshMap>();
-    assert_full::<RapierMap>();
-    assert_map_file::<RapierMap>();
-    assert_memory_usage::<RapierMap>();
+    #[cfg(feature = "rapier")]
+    {
+        assert_full::<RapierMap>();
+        assert_map_file::<RapierMap>();
+        assert_memory_usage::<RapierMap>();
+    }
 }

@@ -190,6 +190,7 @@ mod trimesh_map {
 
 /// The rapier map: one collider per patch in rapier's broad phase, the trimesh map's per-mesh
 /// narrow phase in each collider, hence its tolerance.
+#[cfg(feature = "rapier")]
 mod rapier_map {
     use super::*;
     patch_core::conformance_tests!(
