@@ -264,16 +264,7 @@ pub(crate) fn json_lines(program: &Path, args: &[String]) -> Result<Vec<Value>> 
         .collect()
 }
 
-/// The median of `values` (NaN-free), `None` when empty.
-pub(crate) fn median(mut values: Vec<f64>) -> Option<f64> {
-    values.retain(|v| v.is_finite());
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    Some(if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) })
-}
+pub(crate) use evaluation::stats::median;
 
 /// `ours / theirs` as text (`–` when either is missing or `theirs` is zero).
 pub(crate) fn ratio(ours: Option<f64>, theirs: Option<f64>) -> String {

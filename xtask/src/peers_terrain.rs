@@ -46,11 +46,6 @@ fn frames() -> Result<Vec<(String, PointCloud)>> {
     Ok(out)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The last JSON line a program printed.
 fn json_line(out: &str) -> Result<Value> {
     let line =
@@ -142,7 +137,7 @@ pub fn run(args: &[String]) -> Result<()> {
                 times.push(v["time_seg_s"].as_f64().context("time_seg_s")? * 1e3);
                 last = v;
             }
-            let ms = median(times);
+            let ms = evaluation::stats::median(times).unwrap_or(f64::NAN);
             rows.push(json!({"frame": name, "tool": last["tool"], "method": "ransac-1-plane", "points": cloud.len(),
                 "time_ms": ms, "inliers": last.get("inliers"), "peer": tool}));
             Ok(Some(ms))

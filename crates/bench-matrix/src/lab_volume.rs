@@ -53,11 +53,11 @@
 
 use crate::roadmap::{MatrixArgs, lab_maps};
 use anyhow::{Context, Result, bail};
+use evaluation::thesis;
 use patch_core::{Point3, Real};
 use patch_map::{AnyMap, Backend};
 use patch_pipeline::experiment::lab::{common_box, corner_starts};
 use pointcloud::Aabb;
-use roadmap::thesis;
 use roadmap::volume::{CongruenceTable, VoxelGrid, explored_part};
 use roadmap::{
     MaxIterations, Planner, PlannerKind, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem,

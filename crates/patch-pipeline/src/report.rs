@@ -13,6 +13,7 @@ use crate::results::{
     DemoResults, MapDrawing, MapRow, PlanRun, TerrainSection, TofSection, VolumeSection,
 };
 use anyhow::Result;
+use evaluation::stats::median;
 use html::{DASH, bytes, esc, fixed, int, not_computed, para, seconds, sig, table, yes_no};
 use roadmap::PlannerKind;
 use std::fmt::Write as _;
@@ -257,7 +258,7 @@ fn section_maps(r: &DemoResults) -> String {
     }
     out.push_str("</div>\n<div><h3>Thesis Table 6.1 (Lab)</h3>\n");
     let count = |n: Option<u32>| n.map_or(DASH.to_owned(), int);
-    let rows: Vec<Vec<String>> = roadmap::thesis::TABLE_6_1
+    let rows: Vec<Vec<String>> = evaluation::thesis::TABLE_6_1
         .iter()
         .map(|r| {
             vec![
@@ -276,17 +277,6 @@ fn section_maps(r: &DemoResults) -> String {
     ));
     out.push_str("</div>\n</div>\n");
     out
-}
-
-/// The median of finite values (`None` if there are none).
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) })
 }
 
 /// Distinct values of `key` over `plans`, in first-seen order.
@@ -308,12 +298,8 @@ fn section_plans(r: &DemoResults) -> String {
     let mut medians = Vec::new();
     for planner in distinct(&r.plans, |p| &p.planner) {
         for map in distinct(&r.plans, |p| &p.map) {
-            let times = r
-                .plans
-                .iter()
-                .filter(|p| p.planner == planner && p.map == map)
-                .map(|p| p.seconds)
-                .collect();
+            let times =
+                r.plans.iter().filter(|p| p.planner == planner && p.map == map).map(|p| p.seconds);
             if let Some(m) = median(times) {
                 medians.push(format!("{planner} on {map} {}", seconds(m)));
             }
@@ -553,9 +539,9 @@ fn section_volume(vol: Option<&VolumeSection>) -> String {
         out.push_str(&table(&header_refs, &rows));
     }
     let (thesis, title) = if matches!(v.planner.parse(), Ok(PlannerKind::Prm)) {
-        (&roadmap::thesis::TABLE_6_4_PRM, "Thesis Table 6.4 (PRM, Lab)")
+        (&evaluation::thesis::TABLE_6_4_PRM, "Thesis Table 6.4 (PRM, Lab)")
     } else {
-        (&roadmap::thesis::TABLE_6_2_RRT, "Thesis Table 6.2 (RRT, Lab)")
+        (&evaluation::thesis::TABLE_6_2_RRT, "Thesis Table 6.2 (RRT, Lab)")
     };
     let _ = write!(out, "</div>\n<div><h3>{title}</h3>\n");
     let rows: Vec<Vec<String>> = thesis

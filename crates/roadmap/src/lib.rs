@@ -161,7 +161,6 @@ mod rrt_star;
 pub mod smoothing;
 mod space;
 mod termination;
-pub mod thesis;
 pub mod volume;
 
 pub use connect::RrtConnect;

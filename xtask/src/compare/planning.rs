@@ -214,11 +214,11 @@ fn stats(rows: &[&Value]) -> Stats {
         runs: done.len(),
         skipped: rows.len() - done.len(),
         solved: done.iter().filter(|r| r.get("solved") == Some(&json!(true))).count(),
-        time_s: median(done.iter().filter_map(|r| f(r, "time_s")).collect()),
+        time_s: median(done.iter().filter_map(|r| f(r, "time_s"))),
         us_per_iteration: (it > 0.0).then(|| 1e6 * t / it),
         us_per_check: (checks > 0.0).then(|| 1e6 * t / checks),
-        iterations: median(done.iter().filter_map(|r| f(r, "iterations")).collect()),
-        path_length: median(done.iter().filter_map(|r| f(r, "path_length")).collect()),
+        iterations: median(done.iter().filter_map(|r| f(r, "iterations"))),
+        path_length: median(done.iter().filter_map(|r| f(r, "path_length"))),
     }
 }
 

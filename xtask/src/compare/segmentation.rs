@@ -447,8 +447,7 @@ impl Side {
         if ok.is_empty() && skipped.is_empty() {
             return None;
         }
-        let med =
-            |k: &str| median(ok.iter().filter_map(|r| r.get(k).and_then(Value::as_f64)).collect());
+        let med = |k: &str| median(ok.iter().filter_map(|r| r.get(k).and_then(Value::as_f64)));
         let first = ok.first().map_or(Value::Null, |r| (*r).clone());
         Some(Side {
             method: first["method"].as_str().unwrap_or("?").to_owned(),
@@ -666,8 +665,8 @@ fn summarise(inputs: &[&PerInput]) -> Overall {
             }
             o.off[k] += s.q("planes_off_truth").unwrap_or(0.0) as u64;
         }
-        o.on_surface[k] = median(sides.iter().filter_map(|s| s.q("vertices_on_surface")).collect());
-        o.in_planes[k] = median(sides.iter().filter_map(|s| s.q("points_in_planes")).collect());
+        o.on_surface[k] = median(sides.iter().filter_map(|s| s.q("vertices_on_surface")));
+        o.in_planes[k] = median(sides.iter().filter_map(|s| s.q("points_in_planes")));
     }
     o
 }

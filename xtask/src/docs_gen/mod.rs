@@ -6,7 +6,7 @@
 //! total turns at the median and both quartiles, curviness; [`office`]) per planner and backend,
 //! and the lab RRT time per map at K = 500 (Fig 6.4, whose numbers the thesis gives only as
 //! bounds in its prose, L6813–6818) — with the thesis's figure beside ours (from
-//! [`roadmap::thesis`]) and the ratio ours / thesis, one SVG plot, the provenance of the rows
+//! [`evaluation::thesis`]) and the ratio ours / thesis, one SVG plot, the provenance of the rows
 //! used and the command that made them. A table whose metric the rows lack says so instead.
 //!
 //! Rows used: per scene, those of the git revision of the scene's last matrix row in the file
@@ -22,10 +22,11 @@ mod office;
 mod volume;
 
 use anyhow::{Context, Result, bail};
+use evaluation::thesis;
 use lab::{lab_scans_section, lab_table};
 use office::{office_sections, office_time_svg};
 use patch_map::Backend;
-use roadmap::{PlannerKind, thesis};
+use roadmap::PlannerKind;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -54,17 +55,7 @@ const PLANNERS: [(PlannerKind, &str); 10] = [
     (PlannerKind::PrmValid, "PRM (valid samples)"),
 ];
 
-/// Linear interpolation between closest ranks (type 7); `None` for no values.
-pub fn quantile(values: &[f64], p: f64) -> Option<f64> {
-    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-    if v.is_empty() || !(0.0..=1.0).contains(&p) {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let h = (v.len() - 1) as f64 * p;
-    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
-    Some(v[lo] + (h - lo as f64) * (v[hi] - v[lo]))
-}
+pub use evaluation::stats::quantile;
 
 /// The runs of one cell: seed → metric → value.
 pub type Runs = BTreeMap<u64, BTreeMap<String, f64>>;

@@ -66,6 +66,7 @@ use crate::experiment::ByteCount;
 use crate::input::DepthConvention;
 use crate::input::{CloudInput, read_cloud};
 use anyhow::{Context, Result, bail};
+use evaluation::stats::median;
 use patch_core::triangulate::triangulate_polygon;
 use patch_core::{
     FromPatches as _, Isometry3, Patch, PlanarPatch, Plane, Point3, Real, UnitVector3,
@@ -313,15 +314,6 @@ fn table(out: &mut String, header: &[&str], rows: &[Vec<String>]) {
 
 fn opt(v: Option<Real>, digits: usize) -> String {
     v.map_or_else(|| "–".to_owned(), |v| format!("{v:.digits$}"))
-}
-
-fn median(values: &mut [Real]) -> Option<Real> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(Real::total_cmp);
-    let n = values.len();
-    Some(if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) })
 }
 
 fn mean(values: &[Real]) -> Option<Real> {
@@ -1065,9 +1057,10 @@ fn fidelity_section(
                 all.failures += f.failures;
                 bar.inc(1);
             }
-            let (gt_mean, gt_median) = (mean(&all.vs_gt), median(&mut all.vs_gt));
-            let (true_mean, true_median) = (mean(&all.vs_true), median(&mut all.vs_true));
-            let visible = median(&mut all.visible);
+            let (gt_mean, gt_median) = (mean(&all.vs_gt), median(all.vs_gt.iter().copied()));
+            let (true_mean, true_median) =
+                (mean(&all.vs_true), median(all.vs_true.iter().copied()));
+            let visible = median(all.visible.iter().copied());
             table_rows.push(vec![
                 kind.name().to_owned(),
                 noise_name(kind, level),
@@ -1175,13 +1168,13 @@ fn storage_section(out: &mut String, rows: &mut Vec<Value>, cases: &[Case]) -> R
         }
         let n = map.len();
         let cells = [
-            median(&mut map),
-            median(&mut packed),
-            median(&mut tri_outline),
-            median(&mut tri_ratio),
-            median(&mut tri_region),
-            median(&mut region_ratio),
-            median(&mut vertices),
+            median(map.iter().copied()),
+            median(packed.iter().copied()),
+            median(tri_outline.iter().copied()),
+            median(tri_ratio.iter().copied()),
+            median(tri_region.iter().copied()),
+            median(region_ratio.iter().copied()),
+            median(vertices.iter().copied()),
         ];
         let mut row = vec![format!("ours, lab {} ({n} patches)", kind.name())];
         row.push(opt(cells[0], 0));

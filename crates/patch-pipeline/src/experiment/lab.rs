@@ -50,13 +50,13 @@ use crate::scene_map::{
     BuiltMap, MapKind, MapSource, PcCleaning, ScanSetup, SceneSurfaces, Tessellation, build_map,
 };
 use anyhow::{Context, Result, bail};
+use evaluation::thesis;
 use patch_core::{CapsuleStep, Point3, Real, UnspecificStepIntersector as _};
 use patch_extract::denoise::BeamDenoiseConfig;
 use patch_extract::{MixedPixelConfig, MixedPixelFix};
 use patch_map::{AnyMap, Backend};
 use pointcloud::Aabb;
 use roadmap::metrics::quantile;
-use roadmap::thesis;
 use roadmap::volume::{CongruenceTable, VoxelGrid};
 use roadmap::{
     MaxIterations, Planner as _, PlannerStatus, PlanningSpace, Prm, PrmConfig, Problem, Roadmap,

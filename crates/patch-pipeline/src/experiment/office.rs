@@ -32,7 +32,7 @@
 //! (3/20 = .150, 22/91 = .242); 0 where there are no turns at all.
 //!
 //! # The thesis's figures
-//! Printed beside ours from [`roadmap::thesis`] (Tables 5.3–5.11 with their line references),
+//! Printed beside ours from [`evaluation::thesis`] (Tables 5.3–5.11 with their line references),
 //! the one copy of them in the workspace.
 //!
 //! # Caps
@@ -47,10 +47,11 @@ use crate::problem::{
 use Backend as B;
 use PlannerKind as P;
 use anyhow::{Context, Result, bail};
+use evaluation::stats::quartiles;
+use evaluation::thesis::{self, OFFICE_COLUMNS, OfficeTable, QuartileRatios, Turns};
 use patch_core::{Point3, Real};
 use patch_map::Backend;
 use roadmap::metrics::{added_length, quantile, turn_angles, upper_quartile};
-use roadmap::thesis::{self, OFFICE_COLUMNS, OfficeTable, QuartileRatios, Turns};
 use roadmap::{PathMetrics, Planner, PlannerKind};
 use serde_json::json;
 use std::fmt::Write as _;
@@ -172,11 +173,6 @@ struct Results<'a> {
     cells: Vec<Vec<Cell>>,
 }
 
-/// Lower quartile, median, upper quartile.
-fn quartiles(values: &[Real]) -> Option<[Real; 3]> {
-    Some([quantile(values, 0.25)?, quantile(values, 0.5)?, quantile(values, 0.75)?])
-}
-
 /// A number as the thesis prints it: six significant digits, no trailing zeros, no leading
 /// zero before the decimal point (".010057", "23.1608").
 fn thesis_number(x: Real) -> String {
@@ -240,7 +236,7 @@ type CellFormat = fn(&[RunMetrics]) -> Option<String>;
 /// printed, as the thesis prints it (`None`: its "–").
 type ThesisCell = fn(PlannerKind, usize) -> Option<String>;
 
-/// One printed table: ours, then the thesis's (from [`roadmap::thesis`]).
+/// One printed table: ours, then the thesis's (from [`evaluation::thesis`]).
 struct TableSpec {
     id: &'static str,
     caption: &'static str,

@@ -9,7 +9,7 @@
 //!
 //! ```
 //! use roadmap::PlannerKind;
-//! use roadmap::thesis::{TABLE_5_3, TABLE_5_7};
+//! use evaluation::thesis::{TABLE_5_3, TABLE_5_7};
 //!
 //! // The thesis's median RRT time on Bullet (the fourth column), s.
 //! assert_eq!(TABLE_5_3.cell(PlannerKind::Rrt, 3), Some(0.004721));
@@ -18,7 +18,7 @@
 //! assert_eq!(TABLE_5_7.cell(PlannerKind::Prm, 0).map(|t| t.steep), Some(7));
 //! ```
 
-use crate::PlannerKind;
+use roadmap::PlannerKind;
 
 // ---------------------------------------------------------------------------------------------
 // §5.5.3: the office benchmark (Tables 5.3–5.11).
