@@ -349,7 +349,7 @@ pub fn run(args: &[String]) -> Result<()> {
                     == Some(revision.as_str())
             })
             .collect();
-        for path in crate::ompl_log::write_logs(&rows, &dir)? {
+        for path in evaluation::ompl_log::write_logs(&rows, &dir)? {
             println!("wrote {}", path.display());
         }
     }

@@ -26,9 +26,8 @@ use std::process::ExitCode;
 
 mod bench;
 mod compare;
-mod docs_gen;
+mod docs;
 mod fixtures;
-mod ompl_log;
 mod peers;
 mod provenance;
 
@@ -95,7 +94,7 @@ fn try_main() -> Result<()> {
             Ok(())
         }
         "bench" => bench::run(rest),
-        "docs" => docs_gen::run(rest),
+        "docs" => docs::run(rest),
         "peers" => peers::run(rest),
         "compare" => compare::run(rest),
         "help" | "--help" | "-h" => {

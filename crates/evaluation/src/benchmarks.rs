@@ -1,12 +1,12 @@
-//! `cargo xtask docs`: generates `docs/benchmarks.md` (and its plot, `docs/img/`) from the rows
+//! The benchmarks page (`docs/benchmarks.md`, written by `cargo xtask docs`) and its plot, made from the rows
 //! of the `roadmap` matrix in `target/bench/results.jsonl`.
 //!
 //! The page holds every thesis table the matrix reproduces — the office benchmark's Tables
 //! 5.3–5.11 (median time to reach the four ROIs and its quartiles, added path length, steep and
-//! total turns at the median and both quartiles, curviness; [`office`]) per planner and backend,
+//! total turns at the median and both quartiles, curviness; the `office` module) per planner and backend,
 //! and the lab RRT time per map at K = 500 (Fig 6.4, whose numbers the thesis gives only as
 //! bounds in its prose, L6813–6818) — with the thesis's figure beside ours (from
-//! [`evaluation::thesis`]) and the ratio ours / thesis, one SVG plot, the provenance of the rows
+//! [`crate::thesis`]) and the ratio ours / thesis, one SVG plot, the provenance of the rows
 //! used and the command that made them. A table whose metric the rows lack says so instead.
 //!
 //! Rows used: per scene, those of the git revision of the scene's last matrix row in the file
@@ -21,16 +21,16 @@ use crate::ompl_log::MatrixRow;
 mod office;
 mod volume;
 
-use anyhow::{Context, Result, bail};
-use evaluation::thesis;
+use crate::thesis;
+use anyhow::{Result, bail};
 use lab::{lab_scans_section, lab_table};
-use office::{office_sections, office_time_svg};
+use office::office_sections;
+pub use office::office_time_svg;
 use patch_map::Backend;
 use roadmap::PlannerKind;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
 /// The matrix's backends in the thesis's column order, with the thesis's name for each
 /// ([`thesis::OFFICE_COLUMNS`]; the point-cloud map has no counterpart in its tables).
@@ -55,7 +55,7 @@ const PLANNERS: [(PlannerKind, &str); 10] = [
     (PlannerKind::PrmValid, "PRM (valid samples)"),
 ];
 
-pub use evaluation::stats::quantile;
+pub use crate::stats::quantile;
 
 /// The runs of one cell: seed → metric → value.
 pub type Runs = BTreeMap<u64, BTreeMap<String, f64>>;
@@ -68,22 +68,27 @@ pub struct Matrix {
     pub cells: BTreeMap<(String, Backend, PlannerKind), Runs>,
     /// The rows used.
     pub rows: usize,
-    /// The git revision of the last matrix row, and whether any row used came from a modified
-    /// tree.
+    /// The git revision of the last matrix row.
     pub revision: String,
+    /// Whether any row used came from a modified tree.
     pub dirty: bool,
-    /// Distinct hosts, CPUs, rustc versions, worker counts, commands; first and last date.
+    /// Distinct hosts.
     pub hosts: BTreeSet<String>,
+    /// Distinct CPUs.
     pub cpus: BTreeSet<String>,
+    /// Distinct rustc versions.
     pub rustc: BTreeSet<String>,
+    /// Distinct worker counts.
     pub jobs: BTreeSet<u64>,
+    /// Distinct commands.
     pub commands: BTreeSet<String>,
     /// The commands per scene.
     pub scene_commands: BTreeMap<String, BTreeSet<String>>,
+    /// The first and the last date.
     pub dates: (String, String),
     /// Per scene, the git revision whose rows are used.
     pub scene_revisions: BTreeMap<String, String>,
-    /// The rows of bench `lab-volume` (Tables 6.1, 6.2, 6.4; [`volume::volume_section`] picks
+    /// The rows of bench `lab-volume` (Tables 6.1, 6.2, 6.4; `volume_section` picks
     /// the last run).
     pub volume: Vec<Value>,
 }
@@ -282,33 +287,6 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
     o.push('\n');
     o.push_str(&volume::volume_section(&m.volume));
     Ok(o)
-}
-
-/// Runs `cargo xtask docs [--results FILE] [--out FILE]`.
-pub fn run(args: &[String]) -> Result<()> {
-    let root = crate::project_root();
-    let mut results = root.join("target/bench/results.jsonl");
-    let mut out = root.join("docs/benchmarks.md");
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--results" => results = PathBuf::from(it.next().context("--results needs a path")?),
-            "--out" => out = PathBuf::from(it.next().context("--out needs a path")?),
-            other => bail!("docs takes --results FILE and --out FILE, not `{other}`"),
-        }
-    }
-    let text = std::fs::read_to_string(&results)
-        .with_context(|| format!("reading {}", results.display()))?;
-    let rows: Vec<Value> = text.lines().filter_map(|l| serde_json::from_str(l).ok()).collect();
-    let m = Matrix::from_rows(&rows);
-    let dir = out.parent().context("--out has no folder")?;
-    let img = dir.join("img");
-    std::fs::create_dir_all(&img).with_context(|| format!("creating {}", img.display()))?;
-    let svg = img.join("benchmarks-office-time.svg");
-    pointcloud::io::write_bytes_atomically(&svg, office_time_svg(&m))?;
-    pointcloud::io::write_bytes_atomically(&out, page(&m, "img/benchmarks-office-time.svg")?)?;
-    println!("wrote {} and {} from {} rows", out.display(), svg.display(), m.rows);
-    Ok(())
 }
 
 #[cfg(test)]

@@ -4,11 +4,11 @@
 //! `lab-scans-<kind>` (the thesis's four map types built from simulated ALRF scans, as Fig 6.4
 //! compares them: planes, hybrid and trimesh by patch extraction in the four patch backends,
 //! pc the raw scan points in the point-cloud map). Both put the thesis's prose bounds at
-//! K = 500 (L6813–6818, [`evaluation::thesis`]) beside our RRT medians, with the ratio ours /
+//! K = 500 (L6813–6818, [`crate::thesis`]) beside our RRT medians, with the ratio ours /
 //! bound.
 
 use super::{BACKENDS, Matrix, PLANNERS, quantile, sig3, time_text};
-use evaluation::thesis::{FIG_6_4_PATCH_MAPS_BELOW_S, FIG_6_4_SLOW_MAPS_ABOVE_S, LAB_MAPS};
+use crate::thesis::{FIG_6_4_PATCH_MAPS_BELOW_S, FIG_6_4_SLOW_MAPS_ABOVE_S, LAB_MAPS};
 use patch_map::Backend;
 use roadmap::PlannerKind;
 use std::fmt::Write as _;

@@ -1,7 +1,7 @@
 //! The explored-volume part of `docs/benchmarks.md`: thesis §6.1–6.2 Tables 6.1 (what each of
 //! the lab's four maps holds, L6721–6739), 6.2 (RRT explored volume and congruence,
 //! L6760–6778) and 6.4 (the same for the PRM, L7068–7086) from the rows of `cargo xtask bench
-//! lab-volume`, the thesis's figures ([`evaluation::thesis`]) beside ours.
+//! lab-volume`, the thesis's figures ([`crate::thesis`]) beside ours.
 //!
 //! Rows used: those of bench `lab-volume` from its last run in the results (the git revision
 //! and date of its last row); of several rows of one case and metric, the last. Table 6.1 puts
@@ -10,7 +10,7 @@
 //! every cell.
 
 use super::sig3;
-use evaluation::thesis::{self, LAB_MAPS, TABLE_6_1, VolumeRow};
+use crate::thesis::{self, LAB_MAPS, TABLE_6_1, VolumeRow};
 use roadmap::PlannerKind;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};

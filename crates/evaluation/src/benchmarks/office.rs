@@ -1,7 +1,7 @@
 //! The office part of `docs/benchmarks.md`: thesis §5.5.3 Tables 5.3–5.11 from the matrix
 //! rows of scene `office`, each cell ours / thesis (×ours/thesis), and the plot of Table 5.3.
 //!
-//! The thesis's figures come from [`evaluation::thesis`]. A run's metrics are those
+//! The thesis's figures come from [`crate::thesis`]. A run's metrics are those
 //! `bench-matrix` writes for a run that reached all four ROIs: `time` (s), `path_length` (the
 //! added length of the four paths, m), `turns` and `steep_turns` (sums over the four paths),
 //! `curviness` (the upper quartile of the turn angles of the four paths pooled, °). Tables 5.7–5.9
@@ -9,7 +9,7 @@
 //! the thesis's figures show (3/20 = .150); 0 where a run has no turns.
 
 use super::{BACKENDS, Matrix, PLANNERS, quantile, sig3, time_text};
-use evaluation::thesis::{self, OfficeTable, QuartileRatios, Turns};
+use crate::thesis::{self, OfficeTable, QuartileRatios, Turns};
 use patch_map::Backend;
 use roadmap::PlannerKind;
 use std::fmt::Write as _;
