@@ -188,9 +188,9 @@ pub fn class_name(c: &Classification) -> String {
     format!("{:?}", c.class).to_lowercase()
 }
 
-/// The points ahead: in the levelled frame x > 0, azimuth within ±45°, horizontal range at most
-/// `max_range`.
-fn forward_view(points: &[Point3], mount: &SensorMount, max_range: f64) -> Vec<Point3> {
+/// The points ahead (`patchnav terrain`, the terrain benchmark): in the levelled frame x > 0,
+/// azimuth within ±45°, horizontal range at most `max_range`.
+pub fn forward_view(points: &[Point3], mount: &SensorMount, max_range: f64) -> Vec<Point3> {
     points
         .iter()
         .filter(|p| {

@@ -10,7 +10,6 @@ use anyhow::{Context, Result};
 use hough_terrain::{
     HistogramStyle, HoughClassifier, HoughConfig, SensorAxes, SensorMount, hough_png_file,
 };
-use nalgebra::Point3;
 use pointcloud::io::{self, ReadOptions, depth_png::DepthCamera};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -123,22 +122,7 @@ fn frames() -> Vec<RealFrame> {
     ]
 }
 
-/// Keeps the points ahead: in the levelled frame x > 0, azimuth within ±45°, horizontal range
-/// at most `max_range`.
-pub(crate) fn forward_view(
-    points: &[Point3<f64>],
-    mount: &SensorMount,
-    max_range: f64,
-) -> Vec<Point3<f64>> {
-    points
-        .iter()
-        .filter(|p| {
-            let l = mount.to_levelled(p);
-            l.x > 0.0 && l.y.abs() <= l.x && l.x.hypot(l.y) <= max_range
-        })
-        .copied()
-        .collect()
-}
+pub(crate) use patch_pipeline::terrain::forward_view;
 
 fn out_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/bench/terrain")
