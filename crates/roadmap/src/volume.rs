@@ -360,6 +360,9 @@ struct RowCapsule {
     inv_dyz: Real,
     inv_dx: Real,
     dd_over_dyz: Real,
+    /// For a segment along x (`dyz = 0`), equally close to a row everywhere: its point nearest
+    /// the grid's middle, where the fallback of `row_interval` looks for inside centres.
+    x_along: Real,
 }
 
 /// `⌊x⌋` for `|x|` well inside the `i64` range (no libm call).
@@ -732,6 +735,8 @@ impl VoxelGrid {
             inv_dyz: if dyz > 0.0 { 1.0 / dyz } else { 0.0 },
             inv_dx: if d.x != 0.0 { 1.0 / d.x } else { 0.0 },
             dd_over_dyz: if dyz > 0.0 { dd / dyz } else { 0.0 },
+            x_along: (self.min.x + 0.5 * self.cell * Real::from(self.n))
+                .clamp(a.x.min(b.x), a.x.max(b.x)),
         };
         // Brick cache for one (by, bz) block: x-brick → brick index (u32::MAX: not looked up).
         let (bx0, bx1) = (i0 / BRICK_X, i1 / BRICK_X);
@@ -784,14 +789,7 @@ impl VoxelGrid {
         if ry * ry + rz * rz > cap.r2 + cap.margin {
             return None;
         }
-        let x_closest = if cap.dyz > 0.0 {
-            cap.a.x + t_min * d.x
-        } else {
-            // A segment along x is equally close to the row everywhere: take its point nearest
-            // the grid's middle, so the fallback below looks inside the grid.
-            let mid = self.min.x + 0.5 * self.cell * Real::from(self.n);
-            mid.clamp(cap.a.x.min(cap.b.x), cap.a.x.max(cap.b.x))
-        };
+        let x_closest = if cap.dyz > 0.0 { cap.a.x + t_min * d.x } else { cap.x_along };
         let row = RowTerms::new(cap, ey, ez, y - cap.b.y, z - cap.b.z);
 
         // The analytic interval: end spheres and the cylinder part.

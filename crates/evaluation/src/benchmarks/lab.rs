@@ -33,7 +33,7 @@ fn bound_text(kind: &str, median: f64) -> String {
 
 /// "median (lower–upper quartile)" of `values`, or `None` without values.
 fn quartile_text(values: &[f64]) -> Option<(f64, String)> {
-    let (lo, med, up) = (quantile(values, 0.25)?, quantile(values, 0.5)?, quantile(values, 0.75)?);
+    let [lo, med, up] = crate::stats::quartiles(values)?;
     Some((med, format!("{} ({}–{})", time_text(med), time_text(lo), time_text(up))))
 }
 

@@ -461,8 +461,8 @@ struct TimedRun {
 /// (lower quartile, median, upper quartile) of the runs of `map` at checkpoint `c`.
 fn quartiles(runs: &[TimedRun], map: MapKind, c: usize) -> (f64, f64, f64) {
     let v: Vec<f64> = runs.iter().filter(|r| r.map == map).map(|r| r.seconds[c]).collect();
-    let q = |p| quantile(&v, p).unwrap_or(f64::NAN);
-    (q(0.25), q(0.5), q(0.75))
+    let [q1, m, q3] = evaluation::stats::quartiles(&v).unwrap_or([f64::NAN; 3]);
+    (q1, m, q3)
 }
 
 /// The lab-timing experiment (Fig 6.4; `patchnav experiment lab-timing`): Table 6.1, the
