@@ -22,14 +22,11 @@
 //! the side-by-side tables with ratios ours / theirs to stdout and `target/compare/summary.md`.
 
 use anyhow::{Context, Result, bail};
+use evaluation::compare::{Env, segmentation};
 use serde_json::Value;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
-
-mod mapsize;
-mod planning;
-mod segmentation;
 
 /// The Debian packages the C++ programs need.
 const PACKAGES: [&str; 8] = [
@@ -118,18 +115,6 @@ fn parse(args: &[String]) -> Result<Args> {
     Ok(parsed)
 }
 
-/// The programs and folders every part uses.
-pub(crate) struct Env {
-    /// The release build of `patchnav`.
-    pub(crate) patchnav: PathBuf,
-    /// Where the C++ programs are.
-    pub(crate) build: PathBuf,
-    /// Where rows, inputs and intermediate files go.
-    pub(crate) out: PathBuf,
-    /// The shared bench (floor plan mesh, problem, depth image).
-    pub(crate) bench: PathBuf,
-}
-
 /// Runs `cargo xtask compare ARGS`.
 pub fn run(args: &[String]) -> Result<()> {
     let args = parse(args)?;
@@ -171,18 +156,18 @@ pub fn run(args: &[String]) -> Result<()> {
     };
     if args.planning || args.mapsize {
         // The lab scans feed the lab planning problem and the map sizes.
-        planning::lab_inputs(&env, args.poses)?;
+        evaluation::compare::planning::lab_inputs(&env, args.poses)?;
     }
     if args.planning {
-        let (rows, table) = planning::run(&env, args.seeds)?;
+        let (rows, table) = evaluation::compare::planning::run(&env, args.seeds)?;
         part("planning", rows, table)?;
     }
     if args.mapsize {
-        let (rows, table) = mapsize::run(&env, args.poses)?;
+        let (rows, table) = evaluation::compare::mapsize::run(&env, args.poses)?;
         part("mapsize", rows, table)?;
     }
     if args.segmentation {
-        let mut options = segmentation::Options::from_env();
+        let mut options = segmentation::Options::from_env(&root);
         options.lab_frames = args.lab_frames;
         if let Some(dir) = &args.real_dir {
             options.real_dir = dir.clone();
@@ -239,90 +224,9 @@ fn ensure_packages(install: bool) -> Result<()> {
     Ok(())
 }
 
-/// Runs a program and returns the JSON objects it printed, one per line; a failure is an error
-/// naming the command and the last line of its standard error.
-pub(crate) fn json_lines(program: &Path, args: &[String]) -> Result<Vec<Value>> {
-    let out = Command::new(program)
-        .args(args)
-        .output()
-        .with_context(|| format!("could not start {}", program.display()))?;
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        bail!(
-            "{} {} failed: {}",
-            program.display(),
-            args.join(" "),
-            err.lines().last().unwrap_or("no output")
-        );
-    }
-    String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .filter(|l| l.starts_with('{'))
-        .map(|l| {
-            serde_json::from_str(l).with_context(|| format!("{} printed `{l}`", program.display()))
-        })
-        .collect()
-}
-
-pub(crate) use evaluation::stats::median;
-
-/// `ours / theirs` as text (`–` when either is missing or `theirs` is zero).
-pub(crate) fn ratio(ours: Option<f64>, theirs: Option<f64>) -> String {
-    match (ours, theirs) {
-        (Some(a), Some(b)) if b != 0.0 && a.is_finite() && b.is_finite() => format!("{:.3}", a / b),
-        _ => "–".to_owned(),
-    }
-}
-
-/// A number with three decimals from 1 up, three significant digits below 1, none from 1000
-/// up; `–` when missing.
-pub(crate) fn num(v: Option<f64>) -> String {
-    match v {
-        None => "–".to_owned(),
-        Some(x) if !x.is_finite() => "–".to_owned(),
-        Some(x) if x.abs() >= 1000.0 => format!("{x:.0}"),
-        Some(x) if x.abs() >= 1.0 => format!("{x:.3}"),
-        Some(0.0) => "0".to_owned(),
-        Some(x) => {
-            let decimals = (2.0 - x.abs().log10().floor()).clamp(0.0, 12.0) as usize;
-            format!("{x:.decimals$}")
-        }
-    }
-}
-
-/// `s` as a command-line argument.
-pub(crate) fn arg(s: impl AsRef<std::ffi::OsStr>) -> String {
-    s.as_ref().to_string_lossy().into_owned()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn median_of_odd_and_even_counts_and_nan() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), Some(2.5));
-        assert_eq!(median(vec![f64::NAN]), None);
-        assert_eq!(median(Vec::new()), None);
-    }
-
-    #[test]
-    fn num_keeps_three_significant_digits_below_one() {
-        assert_eq!(num(Some(0.0123456)), "0.0123");
-        assert_eq!(num(Some(0.5)), "0.500");
-        assert_eq!(num(Some(12.34567)), "12.346");
-        assert_eq!(num(Some(123456.7)), "123457");
-        assert_eq!(num(Some(f64::NAN)), "–");
-        assert_eq!(num(None), "–");
-    }
-
-    #[test]
-    fn ratio_guards_zero_and_missing() {
-        assert_eq!(ratio(Some(1.0), Some(4.0)), "0.250");
-        assert_eq!(ratio(Some(1.0), Some(0.0)), "–");
-        assert_eq!(ratio(None, Some(1.0)), "–");
-    }
 
     #[test]
     fn parse_defaults_to_all_and_rejects_bad_seeds() {

@@ -20,7 +20,7 @@
 //!   same inputs in one run, ratios ours/theirs; JSONL rows to `target/compare/`
 //!   (docs/comparison.md).
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -125,11 +125,4 @@ fn build_patchnav(root: &Path) -> Result<PathBuf> {
     Ok(root.join("target/release/patchnav"))
 }
 
-/// Runs a command and returns its standard output, failing with its standard error.
-fn capture(cmd: &mut std::process::Command) -> Result<String> {
-    let out = cmd.output().with_context(|| format!("could not start {cmd:?}"))?;
-    if !out.status.success() {
-        bail!("{cmd:?} failed: {}", String::from_utf8_lossy(&out.stderr).trim());
-    }
-    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
-}
+use evaluation::compare::capture;

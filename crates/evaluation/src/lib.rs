@@ -1,9 +1,11 @@
 //! What the project measures itself against and how it summarises what it measured: the
 //! thesis's published tables ([`thesis`]) and the statistics every experiment, report and
 //! comparison prints ([`stats`]), the benchmarks page `cargo xtask docs` writes
-//! ([`benchmarks`]) and the OMPL benchmark logs of the planning matrix ([`ompl_log`]). Not
-//! published: it serves the pipeline's experiments, the
-//! benchmark matrix and the docs and comparison generators of `xtask`.
+//! ([`benchmarks`]), the OMPL benchmark logs of the planning matrix ([`ompl_log`]), and the
+//! generators of the comparisons with established systems ([`compare`], [`peers`]): they run
+//! both sides on the same inputs, score them against ground truth and tabulate the ratios. Not
+//! published: it serves the pipeline's experiments, the benchmark matrix and `xtask`, which
+//! keeps argument parsing, cargo calls and provenance.
 //!
 //! ```
 //! use evaluation::stats::{median, quantile};
@@ -14,6 +16,8 @@
 //! ```
 
 pub mod benchmarks;
+pub mod compare;
 pub mod ompl_log;
+pub mod peers;
 pub mod stats;
 pub mod thesis;

@@ -10,11 +10,10 @@
 //! Theirs: the in-process segmentation time of one RANSAC plane (1000 iterations, 2 cm), the
 //! median of 3 runs. A peer that is not built or installed gives a line saying how to get it.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use pointcloud::{Point3, PointCloud, SensorPose};
 use scene_sim::{RangeCamera, RangeSensor, StereoCamera, TerrainSpec, terrain};
 use serde_json::{Value, json};
-use std::path::PathBuf;
 use std::process::Command;
 
 /// Camera height above the floor (metres) and the stereo frame's size.
@@ -53,30 +52,12 @@ fn json_line(out: &str) -> Result<Value> {
     Ok(serde_json::from_str(line)?)
 }
 
-/// Runs `cargo xtask peers terrain [--peers-dir D] [--peers-build D] [--out F]`.
-pub fn run(args: &[String]) -> Result<()> {
-    let root = crate::project_root();
-    let mut peers = root.join("../shared/peers");
-    let mut build: Option<PathBuf> = std::env::var_os("PEERS_BUILD_DIR").map(PathBuf::from);
-    let mut out_path = root.join("target/peers/terrain.jsonl");
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut value = || it.next().with_context(|| format!("{a} needs a value"));
-        match a.as_str() {
-            "--peers-dir" => peers = value()?.into(),
-            "--peers-build" => build = Some(value()?.into()),
-            "--out" => out_path = value()?.into(),
-            other => bail!("unknown argument `{other}`"),
-        }
-    }
-    let work = out_path.with_extension("d");
-    std::fs::create_dir_all(&work).with_context(|| format!("creating {}", work.display()))?;
-    let patchnav = crate::build_patchnav(&root)?;
-
-    let build_dir = build.unwrap_or_else(|| {
-        let own = peers.join("build");
-        if own.join("pcl_planes").is_file() { own } else { root.join("target/peers-build") }
-    });
+/// Times our Hough terrain classification and one RANSAC plane fit of each peer on the same
+/// simulated frames: one row per run and the table (a peer that is not built is skipped with a
+/// note on standard error).
+pub fn run(env: &super::Peers) -> Result<(Vec<Value>, String)> {
+    let (work, patchnav, build_dir, peers) =
+        (&env.work, &env.patchnav, &env.build_dir, &env.peers_dir);
     let pcl = build_dir.join("pcl_planes");
     let python = "/usr/bin/python3";
     let open3d_script = peers.join("open3d_planes.py");
@@ -110,7 +91,7 @@ pub fn run(args: &[String]) -> Result<()> {
         let f = file.display().to_string();
         let mut ours = Vec::new();
         for res in RESOLUTIONS {
-            let o = crate::capture(Command::new(&patchnav).args([
+            let o = crate::compare::capture(Command::new(patchnav).args([
                 "terrain",
                 &f,
                 "--axes",
@@ -133,11 +114,11 @@ pub fn run(args: &[String]) -> Result<()> {
             let mut times = Vec::new();
             let mut last = Value::Null;
             for _ in 0..3 {
-                let v = json_line(&crate::capture(&mut cmd())?)?;
+                let v = json_line(&crate::compare::capture(&mut cmd())?)?;
                 times.push(v["time_seg_s"].as_f64().context("time_seg_s")? * 1e3);
                 last = v;
             }
-            let ms = evaluation::stats::median(times).unwrap_or(f64::NAN);
+            let ms = crate::stats::median(times).unwrap_or(f64::NAN);
             rows.push(json!({"frame": name, "tool": last["tool"], "method": "ransac-1-plane", "points": cloud.len(),
                 "time_ms": ms, "inliers": last.get("inliers"), "peer": tool}));
             Ok(Some(ms))
@@ -192,11 +173,5 @@ pub fn run(args: &[String]) -> Result<()> {
             ratio(o3d_ms)
         );
     }
-    let mut text = String::new();
-    for r in &rows {
-        text += &format!("{r}\n");
-    }
-    pointcloud::io::write_bytes_atomically(&out_path, text)?;
-    println!("{table}rows: {}", out_path.display());
-    Ok(())
+    Ok((rows, table))
 }

@@ -36,9 +36,9 @@ const REPS: usize = 3;
 const FLOORPLAN: &str = "floorplan_scan";
 /// Simulated range-camera frames of the lab: 6 frames × 3 repetitions × 2 sides take about
 /// 15 s, so the whole part stays within about two minutes.
-pub(crate) const LAB_FRAMES: usize = 6;
+pub const LAB_FRAMES: usize = 6;
 /// Seed of the lab scene, its frames' poses and the sensor noise.
-pub(crate) const LAB_SEED: u64 = 0;
+pub const LAB_SEED: u64 = 0;
 /// Height of the lab frames' camera above the floor, metres (a camera on a robot's mast).
 const LAB_HEIGHT: f64 = 1.0;
 /// Where the lab frames' cameras look: the middle of the room (x, y), metres.
@@ -116,20 +116,20 @@ const REAL_FRAMES: [RealFrame; 5] = [
 ];
 
 /// What the segmentation part runs on besides the shared bench.
-pub(crate) struct Options {
+pub struct Options {
     /// Simulated lab frames (1 to 64).
-    pub(crate) lab_frames: usize,
+    pub lab_frames: usize,
     /// The real-data folder (skipped with a note when absent).
-    pub(crate) real_dir: PathBuf,
+    pub real_dir: PathBuf,
 }
 
 impl Options {
     /// [`LAB_FRAMES`] frames; the real data at `$PATCHNAV_REAL_DATA`, else `shared/data/real`
-    /// next to the checkout.
-    pub(crate) fn from_env() -> Options {
+    /// next to the checkout at `root`.
+    pub fn from_env(root: &Path) -> Options {
         let real_dir = std::env::var_os(REAL_DATA_VAR)
             .map(PathBuf::from)
-            .unwrap_or_else(|| crate::project_root().join("../shared/data/real"));
+            .unwrap_or_else(|| root.join("../shared/data/real"));
         Options { lab_frames: LAB_FRAMES, real_dir }
     }
 }
@@ -184,7 +184,7 @@ struct Input {
 }
 
 /// Runs both sides [`REPS`] times on every input; returns the rows and the tables.
-pub(crate) fn run_with(env: &Env, options: &Options) -> Result<(Vec<Value>, String)> {
+pub fn run_with(env: &Env, options: &Options) -> Result<(Vec<Value>, String)> {
     if !(1..=64).contains(&options.lab_frames) {
         bail!("the lab frames must be between 1 and 64, got {}", options.lab_frames);
     }

@@ -17,7 +17,7 @@ const RESOLUTIONS: [f64; 2] = [0.05, 0.10];
 /// `memory bytes` and `file bytes` of a map file, from `patchnav map info`.
 fn map_info(patchnav: &Path, file: &Path) -> Result<(u64, u64)> {
     let text =
-        crate::capture(std::process::Command::new(patchnav).args(["map", "info"]).arg(file))?;
+        super::capture(std::process::Command::new(patchnav).args(["map", "info"]).arg(file))?;
     let field = |key: &str| -> Result<u64> {
         text.lines()
             .find_map(|l| l.strip_prefix(key))
@@ -28,7 +28,7 @@ fn map_info(patchnav: &Path, file: &Path) -> Result<(u64, u64)> {
 }
 
 /// Builds every map; returns the rows and the table.
-pub(crate) fn run(env: &Env, poses: usize) -> Result<(Vec<Value>, String)> {
+pub fn run(env: &Env, poses: usize) -> Result<(Vec<Value>, String)> {
     let dir = lab_dir(env);
     let scans = lab_scans(env, poses);
     if let Some(missing) = scans.iter().find(|s| !s.is_file()) {

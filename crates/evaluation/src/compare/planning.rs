@@ -49,18 +49,18 @@ const STOCK: &str = "ompl+fcl";
 const DIRECT: &str = "ompl+fcl direct-goal";
 
 /// The lab folder: scans, extracted maps and the exported mesh.
-pub(crate) fn lab_dir(env: &Env) -> PathBuf {
+pub fn lab_dir(env: &Env) -> PathBuf {
     env.out.join("lab")
 }
 
 /// The lab's scan files, in order.
-pub(crate) fn lab_scans(env: &Env, poses: usize) -> Vec<PathBuf> {
+pub fn lab_scans(env: &Env, poses: usize) -> Vec<PathBuf> {
     (0..poses).map(|i| lab_dir(env).join(format!("scan{i:03}.ply"))).collect()
 }
 
 /// Simulates `poses` ALRF scans of the lab (seed 0) and extracts the planar patch map, exported
 /// as `lab/lab.obj` for the planning problem.
-pub(crate) fn lab_inputs(env: &Env, poses: usize) -> Result<()> {
+pub fn lab_inputs(env: &Env, poses: usize) -> Result<()> {
     let dir = lab_dir(env);
     if dir.exists() {
         std::fs::remove_dir_all(&dir).with_context(|| format!("removing {}", dir.display()))?;
@@ -120,7 +120,7 @@ fn write_problem(env: &Env, name: &str, mode: &str, seeds: u64) -> Result<PathBu
 }
 
 /// Runs every problem × mode × planner on both sides; returns the rows and the table.
-pub(crate) fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
+pub fn run(env: &Env, seeds: u64) -> Result<(Vec<Value>, String)> {
     let omplx = env.build.join("cmp_plan");
     let mut rows = Vec::new();
     for name in ["floorplan", "lab"] {
