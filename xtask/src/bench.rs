@@ -27,6 +27,7 @@
 
 use anyhow::{Context, Result, bail};
 use patch_map::Backend;
+use patch_pipeline::scene_map::MapKind;
 use serde_json::Value;
 use std::collections::HashSet;
 use std::io::{BufRead as _, Write as _};
@@ -61,7 +62,7 @@ pub struct LabMapParams {
 }
 
 /// The map types of the thesis's Table 6.1; `k.pmap` is the file of kind `k`.
-pub const LAB_MAP_KINDS: [&str; 4] = ["planes", "hybrid", "trimesh", "pc"];
+pub const LAB_MAP_KINDS: [MapKind; 4] = MapKind::ALL;
 
 impl Default for LabMapParams {
     /// `patchnav experiment lab-timing`'s defaults.
@@ -94,8 +95,8 @@ impl LabMapParams {
     }
 
     /// The arguments of `patchnav` that build the map of `kind` into `out`.
-    pub fn patchnav_args(&self, kind: &str, out: &Path) -> Vec<String> {
-        let backend = if kind == "pc" { Backend::PointCloud } else { Backend::Polygon };
+    pub fn patchnav_args(&self, kind: MapKind, out: &Path) -> Vec<String> {
+        let backend = if kind == MapKind::Pc { Backend::PointCloud } else { Backend::Polygon };
         let mut a: Vec<String> = [
             "--quiet",
             "map",
@@ -103,7 +104,7 @@ impl LabMapParams {
             "--scene",
             "lab",
             "--kind",
-            kind,
+            kind.name(),
             "--source",
             "scans",
             "--backend",
@@ -448,12 +449,12 @@ mod tests {
         assert!(keys.iter().all(|k| !k.contains('/') && !k.contains(' ')));
         // The patchnav command line builds from scans with the parameters.
         let a = LabMapParams { scan_step_deg: Some(2.0), ..base }
-            .patchnav_args("pc", Path::new("d/pc.pmap"));
+            .patchnav_args(MapKind::Pc, Path::new("d/pc.pmap"));
         let line = a.join(" ");
         assert!(line.contains("map build --scene lab --kind pc --source scans"), "{line}");
         assert!(line.contains("--backend pointcloud") && line.contains("--scans 3"), "{line}");
         assert!(line.contains("--scan-step-deg 2") && line.ends_with("--out d/pc.pmap"), "{line}");
-        let planes = LabMapParams::default().patchnav_args("planes", Path::new("p.pmap"));
+        let planes = LabMapParams::default().patchnav_args(MapKind::Planes, Path::new("p.pmap"));
         assert!(planes.join(" ").contains("--backend polygon"));
         assert!(!planes.iter().any(|a| a == "--scan-step-deg"));
     }

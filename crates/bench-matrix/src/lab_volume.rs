@@ -57,6 +57,7 @@ use evaluation::thesis;
 use patch_core::{Point3, Real};
 use patch_map::{AnyMap, Backend};
 use patch_pipeline::experiment::lab::{common_box, corner_starts};
+use patch_pipeline::scene_map::MapKind;
 use pointcloud::Aabb;
 use roadmap::volume::{CongruenceTable, VoxelGrid, explored_part};
 use roadmap::{
@@ -206,7 +207,7 @@ pub(crate) struct Contents {
 
 /// One of the four maps, in the backend it is planned in.
 struct LabMap {
-    kind: &'static str,
+    kind: MapKind,
     backend: Backend,
     map: AnyMap,
     /// The box it samples in (its own, thesis L6460).
@@ -287,7 +288,7 @@ fn run_with(
         config.jobs
     );
     let grids = run_items(&maps, &items, &empty, config)?;
-    let names: Vec<&str> = maps.iter().map(|m| m.kind).collect();
+    let names: Vec<&str> = maps.iter().map(|m| m.kind.name()).collect();
     for (p, &planner) in PLANNERS.iter().enumerate() {
         let table = CongruenceTable::new(names.iter().copied().zip(grids.iter().map(|g| &g[p])))
             .context("the congruence table")?;
@@ -325,8 +326,8 @@ fn load_maps(folder: &Path) -> Result<Vec<LabMap>> {
     let mut loaded = lab_maps::load(folder, RADIUS)?;
     let point_clouds = scans_of_build(folder);
     let mut maps = Vec::new();
-    for kind in lab_maps::KINDS {
-        let backend = if kind == "pc" { PC_BACKEND } else { PATCH_BACKEND };
+    for kind in MapKind::ALL {
+        let backend = if kind == MapKind::Pc { PC_BACKEND } else { PATCH_BACKEND };
         let (_, map) = loaded
             .take_maps(kind, &[backend])
             .with_context(|| format!("loading the {kind} map"))?
@@ -342,7 +343,7 @@ fn load_maps(folder: &Path) -> Result<Vec<LabMap>> {
             trimesh_patches: counts.trimesh_patches,
             triangles: counts.triangles,
             points: counts.points,
-            point_clouds: if kind == "pc" { point_clouds } else { None },
+            point_clouds: if kind == MapKind::Pc { point_clouds } else { None },
             memory_bytes: map.memory_bytes() as u64,
             file_bytes,
         };
@@ -494,7 +495,7 @@ fn volume_rows(table: &CongruenceTable, maps: &[LabMap], params: &Params<'_>) ->
         let case = format!("lab-volume/{}/{}", params.planner, m.kind);
         let with_map = |mut row: Value| {
             if let Some(obj) = row.as_object_mut() {
-                obj.insert("map".into(), m.kind.into());
+                obj.insert("map".into(), m.kind.name().into());
                 obj.insert("backend".into(), m.backend.name().into());
             }
             row
@@ -506,7 +507,7 @@ fn volume_rows(table: &CongruenceTable, maps: &[LabMap], params: &Params<'_>) ->
             let case = format!("lab-volume/{}/{}/{}", params.planner, m.kind, other.kind);
             let mut row = with_map(params.row(case, "not_in", json!(percent), "%"));
             if let Some(obj) = row.as_object_mut() {
-                obj.insert("column_map".into(), other.kind.into());
+                obj.insert("column_map".into(), other.kind.name().into());
                 obj.insert("voxels_not_in".into(), table.count_not_in(r, c).into());
             }
             rows.push(row);
@@ -536,7 +537,7 @@ fn emit_contents(
     for (metric, value, unit) in metrics {
         let mut row = json!({
             "case": format!("lab-volume/contents/{}", m.kind), "metric": metric, "value": value,
-            "unit": unit, "map": m.kind, "backend": m.backend.name(), "table": "6.1",
+            "unit": unit, "map": m.kind.name(), "backend": m.backend.name(), "table": "6.1",
         });
         if let (Some(key), Some(obj)) = (lab_maps_key, row.as_object_mut()) {
             obj.insert("lab_maps".into(), key.into());
@@ -689,15 +690,22 @@ mod tests {
         assert!(rows.iter().all(|r| r["lab_maps"] == folder));
         // Contents: the tiny maps (2 planar patches; hybrid adds one triangle; trimesh holds
         // the room as 4 triangles in 2 mesh patches; pc the sampled points).
-        let contents =
-            |kind: &str, metric: &str| value(&rows, &format!("lab-volume/contents/{kind}"), metric);
-        assert_eq!(contents("planes", "planar_patches"), 2.0);
-        assert_eq!(contents("hybrid", "trimesh_patches"), 1.0);
-        assert_eq!(contents("hybrid", "triangles"), contents("planes", "triangles") + 1.0);
-        assert_eq!(contents("trimesh", "triangles"), 4.0);
-        assert!(contents("pc", "points") > 1000.0 && contents("pc", "planar_patches") == 0.0);
-        assert_eq!(contents("pc", "point_clouds"), 3.0, "from build.json");
-        for kind in lab_maps::KINDS {
+        let contents = |kind: MapKind, metric: &str| {
+            value(&rows, &format!("lab-volume/contents/{kind}"), metric)
+        };
+        assert_eq!(contents(MapKind::Planes, "planar_patches"), 2.0);
+        assert_eq!(contents(MapKind::Hybrid, "trimesh_patches"), 1.0);
+        assert_eq!(
+            contents(MapKind::Hybrid, "triangles"),
+            contents(MapKind::Planes, "triangles") + 1.0
+        );
+        assert_eq!(contents(MapKind::Trimesh, "triangles"), 4.0);
+        assert!(
+            contents(MapKind::Pc, "points") > 1000.0
+                && contents(MapKind::Pc, "planar_patches") == 0.0
+        );
+        assert_eq!(contents(MapKind::Pc, "point_clouds"), 3.0, "from build.json");
+        for kind in MapKind::ALL {
             let file = std::fs::metadata(lab_maps::map_path(&dir.0, kind)).unwrap().len();
             assert_eq!(contents(kind, "file_bytes"), file as f64);
             assert!(contents(kind, "memory_bytes") > 0.0);
@@ -706,13 +714,13 @@ mod tests {
         let cell =
             rows.iter().find(|r| r["metric"] == "volume").unwrap()["cell_size_m"].as_f64().unwrap();
         for planner in PLANNERS {
-            for row in lab_maps::KINDS {
+            for row in MapKind::ALL {
                 let case = format!("lab-volume/{planner}/{row}");
                 let volume = value(&rows, &case, "volume");
                 let voxels = value(&rows, &case, "voxels");
                 assert!(voxels > 0.0, "{case}");
                 assert!((volume - voxels * cell.powi(3)).abs() < 1e-9 * volume, "{case}");
-                for col in lab_maps::KINDS {
+                for col in MapKind::ALL {
                     let pair = format!("{case}/{col}");
                     let has = rows.iter().any(|r| r["case"] == pair);
                     assert_eq!(has, row != col, "{pair}");
@@ -741,7 +749,7 @@ mod tests {
         assert_eq!(values(&rows), values(&again));
         // More seeds explore at least as much.
         let more = rows_of(&config(3, 2), &dir.0);
-        for kind in lab_maps::KINDS {
+        for kind in MapKind::ALL {
             let case = format!("lab-volume/rrt/{kind}");
             assert!(value(&more, &case, "voxels") >= value(&rows, &case, "voxels"), "{case}");
         }

@@ -56,6 +56,7 @@ use anyhow::{Context, Result, bail};
 use patch_core::{Patch, Point3, Real};
 use patch_map::{AnyMap, Backend, MeshToPatchesConfig, planar_patches_from_mesh};
 use patch_pipeline::experiment::lab::{LAB_ROOM, corner_starts};
+use patch_pipeline::scene_map::MapKind;
 use pointcloud::Aabb;
 use roadmap::metrics::{added_length, turn_angles, upper_quartile};
 use roadmap::{
@@ -515,8 +516,8 @@ const SLOW_ON_SCANNED_TRIMESH: [Backend; 2] = [Backend::Polygon, Backend::BBox6d
 
 /// The backends a `lab-scans-*` scene runs: `selected`, less [`SLOW_ON_SCANNED_TRIMESH`] for the
 /// trimesh map when the backends were not named (`by_default`; a note says so).
-fn lab_scans_backends(kind: &str, selected: &[Backend], by_default: bool) -> Vec<Backend> {
-    if kind != "trimesh" || !by_default {
+fn lab_scans_backends(kind: MapKind, selected: &[Backend], by_default: bool) -> Vec<Backend> {
+    if kind != MapKind::Trimesh || !by_default {
         return selected.to_vec();
     }
     let [a, b] = SLOW_ON_SCANNED_TRIMESH;
@@ -529,7 +530,7 @@ fn lab_scans_backends(kind: &str, selected: &[Backend], by_default: bool) -> Vec
 
 fn lab_scans_setup(
     scene: &'static str,
-    kind: &str,
+    kind: MapKind,
     maps: &mut lab_maps::LabMaps,
     backends: &[Backend],
 ) -> Result<Setup> {
@@ -569,10 +570,10 @@ mod tests {
     #[test]
     fn the_scanned_trimesh_map_leaves_out_slow_backends_unless_they_are_named() {
         let all: Vec<Backend> = Backend::ALL.to_vec();
-        assert_eq!(lab_scans_backends("planes", &all, true), all);
-        assert_eq!(lab_scans_backends("trimesh", &all, false), all);
+        assert_eq!(lab_scans_backends(MapKind::Planes, &all, true), all);
+        assert_eq!(lab_scans_backends(MapKind::Trimesh, &all, false), all);
         assert_eq!(
-            lab_scans_backends("trimesh", &all, true),
+            lab_scans_backends(MapKind::Trimesh, &all, true),
             [Backend::Trimesh, Backend::Rapier, Backend::PointCloud]
         );
     }
@@ -658,9 +659,9 @@ mod tests {
         let cases: HashSet<&str> = rows.iter().map(|r| r["case"].as_str().unwrap()).collect();
         // By default the trimesh map leaves out the two slow backends.
         assert_eq!(cases.len(), 2 * 4 + 2 + 1, "planes, hybrid × 4 + trimesh × 2 + pc: {cases:?}");
-        for kind in ["planes", "hybrid", "trimesh"] {
+        for kind in [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh] {
             for backend in Backend::patch_backends() {
-                let slow = kind == "trimesh" && SLOW_ON_SCANNED_TRIMESH.contains(&backend);
+                let slow = kind == MapKind::Trimesh && SLOW_ON_SCANNED_TRIMESH.contains(&backend);
                 let case = format!("lab-scans-{kind}/{backend}/rrt/3");
                 assert_eq!(cases.contains(case.as_str()), !slow, "{case}");
             }

@@ -16,6 +16,7 @@ use anyhow::{Context, Result, bail};
 use patch_core::{Point3, Real};
 use patch_map::{AnyMap, Backend, load_any};
 use patch_pipeline::experiment::lab::{LAB_ROOM, common_box, corner_starts};
+use patch_pipeline::scene_map::MapKind;
 use pointcloud::Aabb;
 use std::fs::File;
 use std::io::BufReader;
@@ -25,20 +26,15 @@ use std::path::{Path, PathBuf};
 pub(crate) const LAB_MAPS_ENV: &str = "PATCHNAV_LAB_MAPS";
 /// The prefix of the scenes planned on these maps: scene `lab-scans-<kind>`.
 pub(crate) const SCENE_PREFIX: &str = "lab-scans-";
-/// The thesis's map types (Table 6.1), in its order of discussion; the file of kind `k` is
-/// `k.pmap`.
-pub(crate) const KINDS: [&str; 4] = ["planes", "hybrid", "trimesh", "pc"];
-
 /// The map kind of a scene `lab-scans-<kind>`, if it is one.
-pub(crate) fn kind_of(scene: &str) -> Option<&'static str> {
-    let kind = scene.strip_prefix(SCENE_PREFIX)?;
-    KINDS.iter().copied().find(|k| *k == kind)
+pub(crate) fn kind_of(scene: &str) -> Option<MapKind> {
+    scene.strip_prefix(SCENE_PREFIX)?.parse().ok()
 }
 
 /// Whether `backend` can hold a map of `kind`: the patch backends hold the patch maps, the
 /// point-cloud map holds `pc`.
-pub(crate) fn holds(backend: Backend, kind: &str) -> bool {
-    backend.holds_patches() != (kind == "pc")
+pub(crate) fn holds(backend: Backend, kind: MapKind) -> bool {
+    backend.holds_patches() != (kind == MapKind::Pc)
 }
 
 /// The folder of map files named by [`LAB_MAPS_ENV`], if set.
@@ -50,16 +46,16 @@ pub(crate) fn folder_from_env() -> Option<PathBuf> {
 pub(crate) struct LabMaps {
     /// The folder they came from (its name goes into every row as `lab_maps`).
     pub folder: PathBuf,
-    /// Per kind of [`KINDS`], the map as its file holds it (`None` once taken).
-    maps: Vec<(&'static str, Option<AnyMap>)>,
+    /// Per kind of [`MapKind::ALL`] (the thesis's map types, Table 6.1), the map as its file holds it (`None` once taken).
+    maps: Vec<(MapKind, Option<AnyMap>)>,
     /// Per kind, the box the map samples in.
-    bounds: Vec<(&'static str, Aabb)>,
+    bounds: Vec<(MapKind, Aabb)>,
     /// The RRT's start: free on all four maps.
     pub start: Point3,
 }
 
 /// The path of the map file of `kind` in `folder`: `<kind>.pmap`.
-pub(crate) fn map_path(folder: &Path, kind: &str) -> PathBuf {
+pub(crate) fn map_path(folder: &Path, kind: MapKind) -> PathBuf {
     folder.join(format!("{kind}.pmap"))
 }
 
@@ -71,7 +67,7 @@ pub(crate) fn map_path(folder: &Path, kind: &str) -> PathBuf {
 pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
     let mut maps = Vec::new();
     let mut bounds = Vec::new();
-    for kind in KINDS {
+    for kind in MapKind::ALL {
         let path = map_path(folder, kind);
         let file = File::open(&path).with_context(|| {
             format!(
@@ -83,8 +79,8 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
         let map = load_any(BufReader::new(file))
             .with_context(|| format!("reading {}", path.display()))?;
         match (kind, &map) {
-            ("pc", AnyMap::PointCloud(_)) => {}
-            ("pc", other) => bail!(
+            (MapKind::Pc, AnyMap::PointCloud(_)) => {}
+            (MapKind::Pc, other) => bail!(
                 "{}: the pc map must be a point-cloud map, not a `{}` map",
                 path.display(),
                 other.backend()
@@ -110,7 +106,7 @@ pub(crate) fn load(folder: &Path, radius: Real) -> Result<LabMaps> {
 
 impl LabMaps {
     /// The box the map of `kind` samples in.
-    pub(crate) fn bounds(&self, kind: &str) -> Result<Aabb> {
+    pub(crate) fn bounds(&self, kind: MapKind) -> Result<Aabb> {
         self.bounds.iter().find(|(k, _)| *k == kind).map(|(_, b)| *b).context("no such map kind")
     }
 
@@ -119,7 +115,7 @@ impl LabMaps {
     /// are built from its patches. Takes the map: a second call for `kind` is an error.
     pub(crate) fn take_maps(
         &mut self,
-        kind: &str,
+        kind: MapKind,
         backends: &[Backend],
     ) -> Result<Vec<(Backend, AnyMap)>> {
         let slot = self.maps.iter_mut().find(|(k, _)| *k == kind).context("no such map kind")?;
@@ -225,9 +221,9 @@ pub(crate) mod tests {
         let mut maps = load(&dir.0, 0.3).unwrap();
         // The start lies inside every map's box and is free on all four.
         assert_eq!(maps.start, p(0.6, 0.6, 1.0));
-        assert!(maps.bounds("pc").unwrap().max.z > 1.9);
+        assert!(maps.bounds(MapKind::Pc).unwrap().max.z > 1.9);
         let all = Backend::ALL;
-        let hybrid = maps.take_maps("hybrid", &all).unwrap();
+        let hybrid = maps.take_maps(MapKind::Hybrid, &all).unwrap();
         let names: Vec<Backend> = hybrid.iter().map(|m| m.0).collect();
         assert_eq!(
             names,
@@ -238,12 +234,12 @@ pub(crate) mod tests {
             assert_eq!(map.backend(), *backend);
             assert_eq!(map.patches().unwrap().len(), 3, "{backend}");
         }
-        assert!(maps.take_maps("hybrid", &all).is_err(), "taken once");
-        let pc = maps.take_maps("pc", &all).unwrap();
+        assert!(maps.take_maps(MapKind::Hybrid, &all).is_err(), "taken once");
+        let pc = maps.take_maps(MapKind::Pc, &all).unwrap();
         assert_eq!(pc.len(), 1);
         assert_eq!(pc[0].1.backend(), Backend::PointCloud);
-        assert!(maps.take_maps("planes", &[Backend::PointCloud]).unwrap().is_empty());
-        assert_eq!(kind_of("lab-scans-pc"), Some("pc"));
+        assert!(maps.take_maps(MapKind::Planes, &[Backend::PointCloud]).unwrap().is_empty());
+        assert_eq!(kind_of("lab-scans-pc"), Some(MapKind::Pc));
         assert_eq!(kind_of("lab-scans-moon"), None);
         assert_eq!(kind_of("lab"), None);
     }
