@@ -278,32 +278,105 @@ fn find_polygons(path: &Path) -> Result<Value> {
     serde_json::from_str(&text).with_context(|| format!("{} is not JSON", file.display()))
 }
 
-/// A plane `normal · x = offset` with the normal's largest component positive.
-#[derive(Clone, Copy, Debug)]
-struct Plane {
-    normal: Vector3,
-    offset: f64,
+/// A plane `normal · p = offset` with a unit normal.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub(crate) struct Plane {
+    pub(crate) normal: Vector3,
+    pub(crate) offset: f64,
 }
 
 impl Plane {
-    fn canonical(normal: Vector3, offset: f64) -> Option<Plane> {
+    /// The plane with `normal` (any length > 0) and `offset` scaled alike; `None` when either is
+    /// not finite or the normal is zero.
+    pub(crate) fn new(normal: Vector3, offset: f64) -> Option<Plane> {
         let len = normal.norm();
-        if len.is_nan() || len <= 0.0 || !offset.is_finite() {
-            return None;
-        }
-        let (mut n, mut d) = (normal / len, offset / len);
-        let big = n.iamax();
-        if n[big] < 0.0 {
-            n = -n;
-            d = -d;
-        }
-        Some(Plane { normal: n, offset: d })
+        (len.is_finite() && len > 0.0 && offset.is_finite())
+            .then(|| Plane { normal: normal / len, offset: offset / len })
     }
 
-    fn matches(&self, other: &Plane, angle_deg: f64, offset: f64) -> bool {
-        self.normal.dot(&other.normal) >= angle_deg.to_radians().cos()
-            && (self.offset - other.offset).abs() <= offset
+    /// [`Plane::new`] with the normal's largest component positive (one orientation per
+    /// plane, for grouping and printing).
+    fn canonical(normal: Vector3, offset: f64) -> Option<Plane> {
+        let p = Plane::new(normal, offset)?;
+        Some(if p.normal[p.normal.iamax()] < 0.0 {
+            Plane { normal: -p.normal, offset: -p.offset }
+        } else {
+            p
+        })
     }
+
+    /// Whether `other` is the same plane within `angle_deg` and `dist`, in either orientation.
+    pub(crate) fn same(&self, other: &Plane, angle_deg: f64, dist: f64) -> bool {
+        let dot = self.normal.dot(&other.normal);
+        let sign = if dot < 0.0 { -1.0 } else { 1.0 };
+        dot.abs() >= angle_deg.to_radians().cos()
+            && (self.offset - sign * other.offset).abs() <= dist
+    }
+
+    /// Distance of `p` from the plane.
+    fn distance(&self, p: &Point3) -> f64 {
+        (self.normal.dot(&p.coords) - self.offset).abs()
+    }
+}
+
+/// One plane of a run's plane-polygon JSON: its plane and its polygon vertices (outer rings and
+/// holes).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Extracted {
+    /// `None` when the JSON's normal or `d` is missing, zero or not finite.
+    pub(crate) plane: Option<Plane>,
+    pub(crate) corners: Vec<Point3>,
+}
+
+impl Extracted {
+    /// The indices of the `truth` planes this plane matches: normals within
+    /// [`MATCH_ANGLE_DEG`] (either orientation) and the polygon's vertices on average within
+    /// [`MATCH_OFFSET`] of the true plane (measured where the patch is, not at the origin, so
+    /// that a far patch is not penalised for its lever arm).
+    pub(crate) fn matches(&self, truth: &[Plane]) -> Vec<usize> {
+        let Some(plane) = self.plane.filter(|_| !self.corners.is_empty()) else {
+            return Vec::new();
+        };
+        (0..truth.len())
+            .filter(|&i| {
+                let t = &truth[i];
+                let mean = self.corners.iter().map(|q| t.distance(q)).sum::<f64>()
+                    / self.corners.len() as f64;
+                plane.same(t, MATCH_ANGLE_DEG, f64::INFINITY) && mean <= MATCH_OFFSET
+            })
+            .collect()
+    }
+}
+
+/// The planes of a plane-polygon JSON (`{"planes": [{"normal", "d", "polygons", "holes"?}]}`,
+/// each plane `normal · p + d = 0`); missing or malformed parts give empty or `None` fields,
+/// never an error, so that a bad run scores badly instead of stopping the comparison.
+pub(crate) fn parse_planes(polygons: &Value) -> Vec<Extracted> {
+    let num = |v: Option<&Value>| v.and_then(Value::as_f64).unwrap_or(f64::NAN);
+    let point = |v: &Value| {
+        let a = v.as_array();
+        let at = |i: usize| num(a.and_then(|a| a.get(i)));
+        Point3::new(at(0), at(1), at(2))
+    };
+    let planes = polygons.get("planes").and_then(Value::as_array);
+    planes
+        .into_iter()
+        .flatten()
+        .map(|p| {
+            let n = p.get("normal").map(point).unwrap_or(Point3::new(f64::NAN, 0.0, 0.0));
+            let d = num(p.get("d"));
+            let corners = ["polygons", "holes"]
+                .iter()
+                .filter_map(|k| p.get(*k).and_then(Value::as_array))
+                .flatten()
+                .filter_map(Value::as_array)
+                .flatten()
+                .filter(|v| v.is_array())
+                .map(point)
+                .collect();
+            Extracted { plane: Plane::new(n.coords, -d), corners }
+        })
+        .collect()
 }
 
 /// The floor plan's triangles, their distinct planes, and which planes each cloud shows.
@@ -374,53 +447,13 @@ impl Truth {
 
     /// Quality of a run's polygons JSON on `cloud` (see the module docs).
     pub fn quality(&self, cloud: &str, polygons: &Value) -> Value {
-        let planes = polygons.get("planes").and_then(Value::as_array).cloned().unwrap_or_default();
         let visible = self.visible(cloud);
         let mut tally = MatchTally::new(self.planes.len());
-        for p in &planes {
-            let num = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
-            let n = p.get("normal").and_then(Value::as_array).cloned().unwrap_or_default();
-            let normal = Vector3::new(
-                n.first().map_or(f64::NAN, num),
-                n.get(1).map_or(f64::NAN, num),
-                n.get(2).map_or(f64::NAN, num),
-            );
-            let d = p.get("d").map_or(f64::NAN, num);
-            let rings = ["polygons", "holes"]
-                .iter()
-                .filter_map(|k| p.get(*k).and_then(Value::as_array))
-                .flatten()
-                .filter_map(Value::as_array);
-            let mut corners = Vec::new();
-            for ring in rings {
-                for v in ring.iter().filter_map(Value::as_array) {
-                    let q = Point3::new(
-                        v.first().map_or(f64::NAN, num),
-                        v.get(1).map_or(f64::NAN, num),
-                        v.get(2).map_or(f64::NAN, num),
-                    );
-                    tally.vertex(self.nearest(&q).is_some());
-                    corners.push(q);
-                }
+        for e in parse_planes(polygons) {
+            for q in &e.corners {
+                tally.vertex(self.nearest(q).is_some());
             }
-            // A match: normals within MATCH_ANGLE_DEG and the polygon's vertices on average
-            // within MATCH_OFFSET of the true plane (measured where the patch is, not at the
-            // origin, so that a far patch is not penalised for its lever arm).
-            let matched: Vec<usize> = match Plane::canonical(normal, -d) {
-                Some(e) if !corners.is_empty() => (0..self.planes.len())
-                    .filter(|&i| {
-                        let t = &self.planes[i];
-                        let mean = corners
-                            .iter()
-                            .map(|q| (t.normal.dot(&q.coords) - t.offset).abs())
-                            .sum::<f64>()
-                            / corners.len() as f64;
-                        e.matches(t, MATCH_ANGLE_DEG, f64::INFINITY) && mean <= MATCH_OFFSET
-                    })
-                    .collect(),
-                _ => Vec::new(),
-            };
-            tally.plane(matched);
+            tally.plane(e.matches(&self.planes));
         }
         tally.report(visible, |i| {
             let t = &self.planes[i];
@@ -441,7 +474,7 @@ fn distinct_planes(triangles: &[[Point3; 3]]) -> (Vec<Plane>, Vec<usize>) {
         let n = (b - a).cross(&(c - a));
         let plane = Plane::canonical(n, n.dot(&a.coords))
             .unwrap_or(Plane { normal: Vector3::z(), offset: f64::NAN });
-        let i = planes.iter().position(|p| p.matches(&plane, 1.0, 0.01)).unwrap_or_else(|| {
+        let i = planes.iter().position(|p| p.same(&plane, 1.0, 0.01)).unwrap_or_else(|| {
             planes.push(plane);
             planes.len() - 1
         });
@@ -655,7 +688,7 @@ mod tests {
         assert_eq!(of, vec![0, 0, 1]);
         // FORMAT.md writes n · p + d = 0: the floor z = 1 as ((0, 0, -1), 1) matches.
         let e = Plane::canonical(Vector3::new(0.0, 0.0, -1.0), -1.0).unwrap();
-        assert!(e.matches(&planes[0], 2.0, 0.02));
-        assert!(!e.matches(&planes[1], 2.0, 0.02));
+        assert!(e.same(&planes[0], 2.0, 0.02));
+        assert!(!e.same(&planes[1], 2.0, 0.02));
     }
 }

@@ -10,9 +10,10 @@
 //!   the plane's surfaces (the frame's `label` property, exact where the mesh rule counts points
 //!   within 2 cm).
 //! * **found**: a visible true plane that some extracted plane matches: normals within
-//!   [`MATCH_ANGLE_DEG`] (either orientation) and the extracted polygon's vertices on average
-//!   within [`MATCH_OFFSET`] of the true plane. **Off truth**: an extracted plane matching no
-//!   true plane at all (visible or not).
+//!   [`MATCH_ANGLE_DEG`](crate::peers::MATCH_ANGLE_DEG) (either orientation) and the extracted
+//!   polygon's vertices on average within [`MATCH_OFFSET`](crate::peers::MATCH_OFFSET) of the
+//!   true plane. **Off truth**: an extracted plane matching no true plane at all (visible or
+//!   not).
 //! * **vertices on surface**: the share of polygon vertices within [`ON_SURFACE`] of any surface
 //!   of the scene, curved ones included.
 
@@ -20,81 +21,13 @@ use pointcloud::{Point3, Vector3};
 use scene_sim::{Point2, Scene, Shape};
 use serde_json::Value;
 
-use crate::peers::MatchTally;
-pub(crate) use crate::peers::{MATCH_ANGLE_DEG, MATCH_OFFSET, ON_SURFACE, VISIBLE_POINTS};
+use crate::peers::{MatchTally, Plane, parse_planes};
+pub(crate) use crate::peers::{ON_SURFACE, VISIBLE_POINTS};
 
 /// Surfaces lie on one true plane within these (degrees, metres).
 const SAME_PLANE_DEG: f64 = 1.0;
 const SAME_PLANE_M: f64 = 0.01;
 
-/// A plane `normal · p = offset` with a unit normal.
-#[derive(Copy, Clone, Debug, PartialEq)]
-pub(crate) struct Plane {
-    pub(crate) normal: Vector3,
-    pub(crate) offset: f64,
-}
-
-impl Plane {
-    /// The plane with `normal` (any length > 0) and `offset` scaled alike; `None` when either is
-    /// not finite or the normal is zero.
-    pub(crate) fn new(normal: Vector3, offset: f64) -> Option<Plane> {
-        let len = normal.norm();
-        (len.is_finite() && len > 0.0 && offset.is_finite())
-            .then(|| Plane { normal: normal / len, offset: offset / len })
-    }
-
-    /// Whether `other` is the same plane within `angle_deg` and `dist`, in either orientation.
-    fn same(&self, other: &Plane, angle_deg: f64, dist: f64) -> bool {
-        let dot = self.normal.dot(&other.normal);
-        let sign = if dot < 0.0 { -1.0 } else { 1.0 };
-        dot.abs() >= angle_deg.to_radians().cos()
-            && (self.offset - sign * other.offset).abs() <= dist
-    }
-
-    fn distance(&self, p: &Point3) -> f64 {
-        (self.normal.dot(&p.coords) - self.offset).abs()
-    }
-}
-
-/// One plane of a run's plane-polygon JSON: its plane and its polygon vertices (outer rings and
-/// holes).
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Extracted {
-    /// `None` when the JSON's normal or `d` is missing, zero or not finite.
-    pub(crate) plane: Option<Plane>,
-    pub(crate) corners: Vec<Point3>,
-}
-
-/// The planes of a plane-polygon JSON (`{"planes": [{"normal", "d", "polygons", "holes"?}]}`,
-/// each plane `normal · p + d = 0`); missing or malformed parts give empty or `None` fields,
-/// never an error, so that a bad run scores badly instead of stopping the comparison.
-pub(crate) fn parse_planes(polygons: &Value) -> Vec<Extracted> {
-    let num = |v: Option<&Value>| v.and_then(Value::as_f64).unwrap_or(f64::NAN);
-    let point = |v: &Value| {
-        let a = v.as_array();
-        let at = |i: usize| num(a.and_then(|a| a.get(i)));
-        Point3::new(at(0), at(1), at(2))
-    };
-    let planes = polygons.get("planes").and_then(Value::as_array);
-    planes
-        .into_iter()
-        .flatten()
-        .map(|p| {
-            let n = p.get("normal").map(point).unwrap_or(Point3::new(f64::NAN, 0.0, 0.0));
-            let d = num(p.get("d"));
-            let corners = ["polygons", "holes"]
-                .iter()
-                .filter_map(|k| p.get(*k).and_then(Value::as_array))
-                .flatten()
-                .filter_map(Value::as_array)
-                .flatten()
-                .filter(|v| v.is_array())
-                .map(point)
-                .collect();
-            Extracted { plane: Plane::new(n.coords, -d), corners }
-        })
-        .collect()
-}
 
 /// The true planes of a scene and the exact surfaces to measure vertices against.
 pub(crate) struct SceneTruth {
@@ -165,18 +98,7 @@ impl SceneTruth {
             for q in &e.corners {
                 tally.vertex(self.on_surface(q));
             }
-            let matched: Vec<usize> = match e.plane {
-                Some(plane) if !e.corners.is_empty() => (0..self.planes.len())
-                    .filter(|&i| {
-                        let t = &self.planes[i];
-                        let mean = e.corners.iter().map(|q| t.distance(q)).sum::<f64>()
-                            / e.corners.len() as f64;
-                        plane.same(t, MATCH_ANGLE_DEG, f64::INFINITY) && mean <= MATCH_OFFSET
-                    })
-                    .collect(),
-                _ => Vec::new(),
-            };
-            tally.plane(matched);
+            tally.plane(e.matches(&self.planes));
         }
         tally.report(visible, |i| {
             let t = &self.planes[i];
