@@ -28,7 +28,6 @@ pub(crate) use crate::peers::{ON_SURFACE, VISIBLE_POINTS};
 const SAME_PLANE_DEG: f64 = 1.0;
 const SAME_PLANE_M: f64 = 0.01;
 
-
 /// The true planes of a scene and the exact surfaces to measure vertices against.
 pub(crate) struct SceneTruth {
     scene: Scene,
