@@ -66,6 +66,12 @@ const BENCHES: &[Bench] = &[
         run: Run::Rows(terrain::run),
     },
     Bench {
+        name: "terrain-mount",
+        about: "mount self-calibration (height, pitch, roll from the ground plane) on the simulated \
+                snapshots of Table 4.3 from a level and a tilted mount: per frame and over the drive",
+        run: Run::Rows(terrain::run_mount),
+    },
+    Bench {
         name: "roadmap",
         about: "Tables 5.3-5.11, Fig 6.4: scenes (office, lab, lab-scans-{planes,hybrid,trimesh,pc} with \
                 $PATCHNAV_LAB_MAPS) x backends x planners x seeds; \

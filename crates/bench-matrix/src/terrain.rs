@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use hough_terrain::TerrainClass;
 use serde_json::{Value, json};
 
+mod mount;
 mod real;
 mod speed;
 mod synthetic;
@@ -21,15 +22,26 @@ use synthetic::{CaseResult, Outcome, RESOLUTIONS, Sensor};
 /// Snapshots per parameter set by default.
 const DEFAULT_SNAPSHOTS: usize = 20;
 
+/// Snapshots per parameter set: `PATCHNAV_TERRAIN_SNAPSHOTS`, else [`DEFAULT_SNAPSHOTS`].
+fn snapshots() -> Result<usize> {
+    Ok(match std::env::var("PATCHNAV_TERRAIN_SNAPSHOTS") {
+        Ok(v) => {
+            v.parse::<usize>().ok().filter(|&n| (1..=10_000).contains(&n)).with_context(|| {
+                format!("PATCHNAV_TERRAIN_SNAPSHOTS must be a count in 1..=10000, not `{v}`")
+            })?
+        }
+        Err(_) => DEFAULT_SNAPSHOTS,
+    })
+}
+
+/// Runs the `terrain-mount` benchmark: the mount self-calibration on the simulated snapshots.
+pub fn run_mount(seed: u64) -> Result<Vec<Value>> {
+    mount::run(snapshots()?, seed)
+}
+
 /// Runs the terrain benchmark.
 pub fn run(seed: u64) -> Result<Vec<Value>> {
-    let n =
-        match std::env::var("PATCHNAV_TERRAIN_SNAPSHOTS") {
-            Ok(v) => v.parse::<usize>().ok().filter(|&n| (1..=10_000).contains(&n)).with_context(
-                || format!("PATCHNAV_TERRAIN_SNAPSHOTS must be a count in 1..=10000, not `{v}`"),
-            )?,
-            Err(_) => DEFAULT_SNAPSHOTS,
-        };
+    let n = snapshots()?;
     let mut rows = Vec::new();
     eprintln!(
         "Simulated snapshots: camera {} m above the floor, pitched down {}°, optical axes; {n} snapshots \

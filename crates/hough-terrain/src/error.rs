@@ -58,6 +58,24 @@ pub enum HoughError {
         /// What differs.
         why: String,
     },
+    /// Too few usable points (finite, within range) for a fit.
+    #[error("{got} usable points, at least {need} needed")]
+    NotEnoughPoints {
+        /// Usable points.
+        got: usize,
+        /// Points needed.
+        need: usize,
+    },
+    /// The mount search found no plane within its tilt and height limits.
+    #[error(
+        "no ground plane found: none of {tried} sampled planes was within {max_tilt_deg:.0}° of level and the height limits with its points spread over an area"
+    )]
+    NoGround {
+        /// Planes sampled.
+        tried: usize,
+        /// The tilt limit, degrees.
+        max_tilt_deg: f64,
+    },
     /// Writing the histogram image.
     #[error("writing PNG: {0}")]
     Png(String),

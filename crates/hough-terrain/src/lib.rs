@@ -65,6 +65,7 @@
 //! | timing (Fig 4.4, 5–50 ms per frame) | `benches/hough.rs` |
 //! | beyond: per-sector classification | [`SectorClassifier`], [`SectorGrid`] |
 //! | beyond: equal-area ball accumulator (Borrmann et al. 2011) | [`BallAccumulator`], [`refine_plane`] |
+//! | beyond: mount self-calibration (height, pitch, roll from the ground plane; one frame or a running window) | [`estimate_mount`], [`MountSearch`], [`MountWindow`] |
 //!
 //! # Conventions
 //!
@@ -106,6 +107,7 @@
 
 pub mod accumulator;
 pub mod ball;
+pub mod calibrate;
 pub mod classifier;
 pub mod classify;
 pub mod error;
@@ -116,6 +118,7 @@ pub mod space;
 
 pub use accumulator::{Accumulator, NormalTable, vote_literal};
 pub use ball::{BallAccumulator, BallConfig, BallPlane, refine_plane};
+pub use calibrate::{MountEstimate, MountSearch, MountWindow, estimate_mount};
 pub use classifier::{HoughClassifier, HoughConfig};
 pub use classify::{
     BinType, Classification, ClassifierConfig, Preprocessing, RobotLimits, Rule, TerrainClass,

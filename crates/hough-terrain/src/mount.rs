@@ -24,7 +24,7 @@ pub enum SensorAxes {
 
 impl SensorAxes {
     /// The rotation taking this frame's vectors to body axes (x forward, y left, z up).
-    fn body_from_sensor(self) -> Matrix3<f64> {
+    pub(crate) fn body_from_sensor(self) -> Matrix3<f64> {
         match self {
             SensorAxes::Body => Matrix3::identity(),
             SensorAxes::Optical => Matrix3::new(0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, -1.0, 0.0),

@@ -3,15 +3,16 @@
 //! classify a frame.
 //!
 //! The frame's points are levelled with the sensor's axes, height and pitch
-//! ([`SensorMount::looking_ahead`]), optionally cut to the forward view (±45° of azimuth, a
+//! ([`SensorMount::looking_ahead`]), given or estimated from the frame's ground plane
+//! ([`estimate_mount`]: height, pitch and roll), optionally cut to the forward view (±45° of azimuth, a
 //! horizontal range limit), voted into the thesis's Hough space at the chosen angular
 //! resolution and classified by Algorithm 3 with the thesis's thresholds.
 
 use crate::input::{self, CloudInput};
 use anyhow::{Context, Result, bail, ensure};
 use hough_terrain::{
-    Classification, HistogramStyle, HoughClassifier, HoughConfig, SectorClassifier, SectorGrid,
-    SensorAxes, SensorMount, hough_png_file,
+    Classification, HistogramStyle, HoughClassifier, HoughConfig, MountEstimate, MountSearch,
+    SectorClassifier, SectorGrid, SensorAxes, SensorMount, estimate_mount, hough_png_file,
 };
 use pointcloud::Point3;
 use std::path::PathBuf;
@@ -42,10 +43,12 @@ pub struct TerrainSetup {
     pub hough_png: Option<PathBuf>,
     /// The sensor's axes (`None`: camera for organised frames, lidar otherwise).
     pub axes: Option<AxesChoice>,
-    /// The sensor's height above the floor, metres.
-    pub sensor_height: f64,
-    /// The sensor's pitch, degrees down from level.
-    pub pitch: f64,
+    /// The sensor's height above the floor, metres (`None`: estimated from the frame with
+    /// [`estimate_mount`], as are pitch and roll).
+    pub sensor_height: Option<f64>,
+    /// The sensor's pitch, degrees down from level (`None`: estimated from the frame, or level
+    /// when the height is given).
+    pub pitch: Option<f64>,
     /// Keep only points ahead (±45° of azimuth) within this horizontal range, metres. Lidar
     /// frames are always cut to the forward view.
     pub max_range: Option<f64>,
@@ -56,8 +59,8 @@ pub struct TerrainSetup {
 }
 
 impl TerrainSetup {
-    /// The command line's defaults for `frame`: 15° bins, a level sensor 0.45 m up, the whole
-    /// view, one run.
+    /// The command line's defaults for `frame`: 15° bins, the mount estimated from the frame,
+    /// the whole view, one run.
     pub fn new(frame: PathBuf) -> TerrainSetup {
         TerrainSetup {
             frame,
@@ -65,8 +68,8 @@ impl TerrainSetup {
             sectors: None,
             hough_png: None,
             axes: None,
-            sensor_height: 0.45,
-            pitch: 0.0,
+            sensor_height: None,
+            pitch: None,
             max_range: None,
             repeat: 1,
             input: CloudInput::default(),
@@ -83,6 +86,10 @@ pub struct Classified {
     pub points: Vec<Point3>,
     /// The axes used.
     pub axes: AxesChoice,
+    /// The mount used: height (m), pitch and roll (degrees down, degrees).
+    pub mount: (f64, f64, f64),
+    /// The estimate, when the mount (or part of it) came from the frame.
+    pub estimated: Option<MountEstimate>,
     /// The whole view's classification.
     pub result: Classification,
     /// Median classification time, seconds.
@@ -105,15 +112,15 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         "--resolution must be in (0, 90] degrees, not {}",
         args.resolution
     );
-    ensure!(
-        args.sensor_height.is_finite() && args.sensor_height.abs() <= 100.0,
-        "--sensor-height must be a finite height in metres, not {}",
-        args.sensor_height
-    );
-    ensure!(
-        args.pitch.is_finite() && args.pitch.abs() < 90.0,
-        "--pitch must be in (−90, 90) degrees"
-    );
+    if let Some(h) = args.sensor_height {
+        ensure!(
+            h.is_finite() && h.abs() <= 100.0,
+            "--sensor-height must be a finite height in metres, not {h}"
+        );
+    }
+    if let Some(p) = args.pitch {
+        ensure!(p.is_finite() && p.abs() < 90.0, "--pitch must be in (−90, 90) degrees, not {p}");
+    }
     if let Some(r) = args.max_range {
         ensure!(
             r.is_finite() && r > 0.0,
@@ -133,8 +140,23 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         AxesChoice::Lidar => SensorAxes::Body,
         AxesChoice::Camera => SensorAxes::Optical,
     };
-    let mount =
-        SensorMount::looking_ahead(args.sensor_height, args.pitch.to_radians(), 0.0, sensor_axes)?;
+    let estimated = match args.sensor_height {
+        Some(_) => None,
+        None => {
+            Some(estimate_mount(cloud.positions(), &MountSearch::new(sensor_axes)).with_context(
+                || {
+                    format!(
+                        "{}: estimating the sensor's mount (give --sensor-height and --pitch)",
+                        args.frame.display()
+                    )
+                },
+            )?)
+        }
+    };
+    let height = args.sensor_height.or(estimated.map(|e| e.height)).context("a height")?;
+    let pitch = args.pitch.map(f64::to_radians).or(estimated.map(|e| e.pitch)).unwrap_or(0.0);
+    let roll = estimated.map_or(0.0, |e| e.roll);
+    let mount = SensorMount::looking_ahead(height, pitch, roll, sensor_axes)?;
     let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
     let cut = args.max_range.is_some() || axes == AxesChoice::Lidar;
     let (points, pixels): (Vec<Point3>, usize) = if cut {
@@ -180,7 +202,17 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         None => Vec::new(),
     };
 
-    Ok(Classified { cloud_points: cloud.len(), points, axes, result, seconds, classifier, sectors })
+    Ok(Classified {
+        cloud_points: cloud.len(),
+        points,
+        axes,
+        mount: (height, pitch.to_degrees(), roll.to_degrees()),
+        estimated,
+        result,
+        seconds,
+        classifier,
+        sectors,
+    })
 }
 
 /// The class's lower-case name (`floor`, `ramp`, ...).

@@ -26,13 +26,14 @@ pub struct TerrainArgs {
     /// clouds), lidar otherwise].
     #[arg(long, value_parser = crate::names::all::<AxesChoice>())]
     pub axes: Option<AxesChoice>,
-    /// The sensor's height above the floor, metres (fixes the floor bin; the thesis does not
-    /// give Rugbot's: 0.45 m is a level camera on a Rugbot-sized robot).
-    #[arg(long, default_value_t = 0.45)]
-    pub sensor_height: f64,
-    /// The sensor's pitch, degrees down from level.
-    #[arg(long, default_value_t = 0.0)]
-    pub pitch: f64,
+    /// The sensor's height above the floor, metres (fixes the floor bin) [default: estimated
+    /// from the frame's ground plane, with pitch and roll].
+    #[arg(long)]
+    pub sensor_height: Option<f64>,
+    /// The sensor's pitch, degrees down from level [default: estimated from the frame; level
+    /// when --sensor-height is given].
+    #[arg(long)]
+    pub pitch: Option<f64>,
     /// Keep only points ahead (±45° of azimuth) within this horizontal range, metres. Lidar
     /// frames are always cut to the forward view (the method classifies the terrain ahead).
     #[arg(long)]
@@ -67,8 +68,17 @@ impl TerrainArgs {
 
 /// Runs `patchnav terrain`.
 pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
-    let Classified { cloud_points, points, axes, result, seconds, classifier, sectors } =
-        classify(&args.setup())?;
+    let Classified {
+        cloud_points,
+        points,
+        axes,
+        mount: (height, pitch, roll),
+        estimated,
+        result,
+        seconds,
+        classifier,
+        sectors,
+    } = classify(&args.setup())?;
     if args.json {
         let sectors: Vec<_> = sectors
             .iter()
@@ -86,20 +96,27 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
             "accepted": result.accepted, "rule": format!("{:?}", result.rule), "plane": plane,
             "votes": result.votes, "high_bins": result.high_bins, "time_ms": seconds * 1e3, "repeat": args.repeat,
             "sectors": sectors,
+            "mount": {"height_m": height, "pitch_deg": pitch, "roll_deg": roll,
+                "estimated": estimated.map(|e| serde_json::json!({"inliers": e.inliers, "points": e.points, "rms_m": e.rms}))},
         });
         progress.report(row.to_string());
         return Ok(());
     }
     let space = classifier.config().space;
     progress.report(format!(
-        "frame:     {} ({} points, {} used; {:?} axes, {} m up, pitched {}° down)",
+        "frame:     {} ({} points, {} used; {:?} axes)",
         args.frame.display(),
         cloud_points,
         points.len(),
         axes,
-        args.sensor_height,
-        args.pitch
     ));
+    progress.report(match estimated {
+        Some(e) => format!(
+            "mount:     {height:.2} m up, pitched {pitch:.1}° down, rolled {roll:.1}° (estimated: {} of {} points on the ground plane, rms {:.3} m)",
+            e.inliers, e.points, e.rms
+        ),
+        None => format!("mount:     {height:.2} m up, pitched {pitch:.1}° down (given)"),
+    });
     progress.report(format!("class:     {}", class_name(&result)));
     progress.report(format!("drivable:  {}", if result.drivable { "yes" } else { "no" }));
     progress.report(match result.plane {

@@ -8,7 +8,8 @@
 
 use anyhow::{Context, Result};
 use hough_terrain::{
-    HistogramStyle, HoughClassifier, HoughConfig, SensorAxes, SensorMount, hough_png_file,
+    HistogramStyle, HoughClassifier, HoughConfig, MountSearch, SensorAxes, SensorMount,
+    estimate_mount, hough_png_file,
 };
 use pointcloud::io::{self, ReadOptions, depth_png::DepthCamera};
 use serde_json::{Value, json};
@@ -156,66 +157,90 @@ pub(crate) fn run() -> Result<Vec<Value>> {
         } else {
             io::read_cloud(&path, &ReadOptions::STRICT)?
         };
-        let mount = SensorMount::looking_ahead(f.height, f.pitch_deg.to_radians(), 0.0, f.axes)?;
-        let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
-        let (points, pixels) = match f.max_range {
-            Some(r) => {
-                let p = forward_view(cloud.positions(), &mount, r);
-                let n = p.len();
-                (p, n)
-            }
-            None => (cloud.positions().to_vec(), frame_pixels),
-        };
-        if points.is_empty() {
-            eprintln!("SKIPPED: {} (no point ahead)", f.name);
-            continue;
+        let given = SensorMount::looking_ahead(f.height, f.pitch_deg.to_radians(), 0.0, f.axes)?;
+        let estimate = estimate_mount(cloud.positions(), &MountSearch::new(f.axes));
+        let mut mounts =
+            vec![(given, format!("{} / {} ({})", f.height, f.pitch_deg, f.mount_note), "")];
+        match &estimate {
+            Ok(e) => mounts.push((
+                e.mount,
+                format!(
+                    "estimated: {:.2} / {:.1}, roll {:.1}",
+                    e.height,
+                    e.pitch.to_degrees(),
+                    e.roll.to_degrees()
+                ),
+                "/estimated-mount",
+            )),
+            Err(why) => eprintln!("{}: no mount estimate: {why}", f.name),
         }
-        let mut cells = Vec::new();
-        let mut times = Vec::new();
-        for res in super::RESOLUTIONS {
-            let mut c = HoughClassifier::new(HoughConfig::thesis(res.to_radians(), mount)?)?;
-            let mut result = None;
-            let secs = crate::median_seconds(5, || {
-                result = Some(c.classify_frame(&points, pixels)?);
-                Ok(())
-            })?;
-            let r = result.context("classified")?;
-            let plane = r.plane.map_or("–".to_owned(), |p| {
-                format!("({:.0}, {:.0}, {:.2})", p.rho_x.to_degrees(), p.rho_y.to_degrees(), p.d)
-            });
-            cells.push(format!(
-                "{:?}{} {}{plane}",
-                r.class,
-                if r.accepted { "" } else { " (rejected)" },
-                if r.drivable { "drivable " } else { "not drivable " },
-            ));
-            times.push(format!("{:.2}", secs * 1e3));
-            if res == 15.0 {
-                let png = out.join(format!("{}-15deg.png", f.name));
-                hough_png_file(
-                    c.accumulator(),
-                    &HistogramStyle::thesis(Some(c.floor_bin())),
-                    &png,
-                )?;
+        for (mount, mount_label, suffix) in mounts {
+            let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
+            let (points, pixels) = match f.max_range {
+                Some(r) => {
+                    let p = forward_view(cloud.positions(), &mount, r);
+                    let n = p.len();
+                    (p, n)
+                }
+                None => (cloud.positions().to_vec(), frame_pixels),
+            };
+            if points.is_empty() {
+                eprintln!("SKIPPED: {} (no point ahead)", f.name);
+                continue;
             }
-            rows.push(json!({
-                "case": format!("real/{}", f.name), "metric": "time_per_frame", "value": secs * 1e3, "unit": "ms",
-                "resolution_deg": res, "class": format!("{:?}", r.class), "drivable": r.drivable,
-                "accepted": r.accepted, "points": r.points, "high_bins": r.high_bins,
-                "plane": r.plane.map(|p| json!({"rho_x_deg": p.rho_x.to_degrees(), "rho_y_deg": p.rho_y.to_degrees(), "d": p.d})),
-                "mount_height": f.height, "mount_pitch_deg": f.pitch_deg, "mount": f.mount_note,
-            }));
+            let mut cells = Vec::new();
+            let mut times = Vec::new();
+            for res in super::RESOLUTIONS {
+                let mut c = HoughClassifier::new(HoughConfig::thesis(res.to_radians(), mount)?)?;
+                let mut result = None;
+                let secs = crate::median_seconds(5, || {
+                    result = Some(c.classify_frame(&points, pixels)?);
+                    Ok(())
+                })?;
+                let r = result.context("classified")?;
+                let plane = r.plane.map_or("–".to_owned(), |p| {
+                    format!(
+                        "({:.0}, {:.0}, {:.2})",
+                        p.rho_x.to_degrees(),
+                        p.rho_y.to_degrees(),
+                        p.d
+                    )
+                });
+                cells.push(format!(
+                    "{:?}{} {}{plane}",
+                    r.class,
+                    if r.accepted { "" } else { " (rejected)" },
+                    if r.drivable { "drivable " } else { "not drivable " },
+                ));
+                times.push(format!("{:.2}", secs * 1e3));
+                if res == 15.0 {
+                    let png = out.join(format!("{}{}-15deg.png", f.name, suffix.replace('/', "-")));
+                    hough_png_file(
+                        c.accumulator(),
+                        &HistogramStyle::thesis(Some(c.floor_bin())),
+                        &png,
+                    )?;
+                }
+                rows.push(json!({
+                    "case": format!("real/{}{suffix}", f.name), "metric": "time_per_frame", "value": secs * 1e3, "unit": "ms",
+                    "resolution_deg": res, "class": format!("{:?}", r.class), "drivable": r.drivable,
+                    "accepted": r.accepted, "points": r.points, "high_bins": r.high_bins,
+                    "plane": r.plane.map(|p| json!({"rho_x_deg": p.rho_x.to_degrees(), "rho_y_deg": p.rho_y.to_degrees(), "d": p.d})),
+                    "mount_height": f.height, "mount_pitch_deg": f.pitch_deg, "mount": f.mount_note,
+                "mount_used": mount_label,
+                }));
+            }
+            table += &format!(
+                "| {} | {} / {} ({}) | {} | {} | {} |\n",
+                f.name,
+                f.height,
+                f.pitch_deg,
+                f.mount_note,
+                points.len(),
+                cells.join(" | "),
+                times.join(" / ")
+            );
         }
-        table += &format!(
-            "| {} | {} / {} ({}) | {} | {} | {} |\n",
-            f.name,
-            f.height,
-            f.pitch_deg,
-            f.mount_note,
-            points.len(),
-            cells.join(" | "),
-            times.join(" / ")
-        );
     }
     table += &format!("Hough spaces at 15°: {}/*-15deg.png", out.display());
     eprintln!("{table}");

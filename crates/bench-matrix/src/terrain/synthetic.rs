@@ -231,10 +231,21 @@ impl FrameMaker {
         seed: u64,
         points: &mut Vec<Point3<f64>>,
     ) -> Result<usize> {
+        self.frame_from(scene, &body_pose(), seed, points)
+    }
+
+    /// [`FrameMaker::frame`] from another body pose.
+    pub(crate) fn frame_from(
+        &mut self,
+        scene: &Scene,
+        body: &pointcloud::SensorPose,
+        seed: u64,
+        points: &mut Vec<Point3<f64>>,
+    ) -> Result<usize> {
         points.clear();
         let pixels: Result<usize> = match &mut self.tof {
             Some(sim) => {
-                let pose = scene_sim::RangeCamera::swissranger_sr3000().mount(&body_pose());
+                let pose = scene_sim::RangeCamera::swissranger_sr3000().mount(body);
                 let sim_frame = sim.simulate(scene, &pose, seed)?;
                 let frame = &sim_frame.frame;
                 for (i, truth) in sim_frame.truth.radial.iter().enumerate() {
@@ -248,7 +259,7 @@ impl FrameMaker {
                 Ok(n)
             }
             None => {
-                let pose = self.stereo.mount(&body_pose());
+                let pose = self.stereo.mount(body);
                 let cloud = self.stereo.scan(scene, &pose, seed).to_cloud()?;
                 points.extend_from_slice(cloud.positions());
                 Ok(cloud.grid().map_or(cloud.len(), |g| g.num_pixels()))

@@ -211,10 +211,10 @@ pub struct TerrainConfig {
     pub frame: PathBuf,
     /// Hough resolution, degrees.
     pub resolution: f64,
-    /// Sensor height, metres.
-    pub sensor_height: f64,
-    /// Pitch down, degrees.
-    pub pitch: f64,
+    /// Sensor height, metres (`None`: estimated from the frame).
+    pub sensor_height: Option<f64>,
+    /// Pitch down, degrees (`None`: estimated from the frame, or level with a given height).
+    pub pitch: Option<f64>,
     /// Axes (`None`: by the frame).
     pub axes: Option<AxesChoice>,
     /// Horizontal range limit, metres.
@@ -647,15 +647,17 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
             if !(resolution.is_finite() && resolution > 0.0 && resolution <= 90.0) {
                 bail!("terrain.resolution must be in (0, 90] degrees, not {resolution}");
             }
-            let sensor_height = t.sensor_height.unwrap_or(0.45);
-            if !(sensor_height.is_finite() && sensor_height.abs() <= 100.0) {
-                bail!(
-                    "terrain.sensor_height must be a finite height in metres, not {sensor_height}"
-                );
+            let sensor_height = t.sensor_height;
+            if let Some(h) = sensor_height
+                && !(h.is_finite() && h.abs() <= 100.0)
+            {
+                bail!("terrain.sensor_height must be a finite height in metres, not {h}");
             }
-            let pitch = t.pitch.unwrap_or(0.0);
-            if !(pitch.is_finite() && pitch.abs() < 90.0) {
-                bail!("terrain.pitch must be in (-90, 90) degrees, not {pitch}");
+            let pitch = t.pitch;
+            if let Some(p) = pitch
+                && !(p.is_finite() && p.abs() < 90.0)
+            {
+                bail!("terrain.pitch must be in (-90, 90) degrees, not {p}");
             }
             if let Some(r) = t.max_range
                 && !(r.is_finite() && r > 0.0)

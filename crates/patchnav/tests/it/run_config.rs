@@ -61,7 +61,7 @@ fn lab_scans_with_poses_tof_and_terrain() {
         "[input]\nscans = [\"scans/scan000.ply\", \"scans/scan001.ply\"]\nposes = \"scans/poses.json\"\n\
          [plan]\nstart = [0.8, 1.0, 1.0]\ngoals = [[11.0, 1.0, 1.0], [4.0, 6.0, 1.0]]\n\
          [tof]\nrange = \"tof/range.png\"\namplitude = \"tof/amplitude.png\"\nmeta = \"tof/meta.json\"\n\
-         [terrain]\nframe = \"{}\"\naxes = \"camera\"\n[output]\ndir = \"result\"\n",
+         [terrain]\nframe = \"{}\"\naxes = \"camera\"\nsensor_height = 0.45\n[output]\ndir = \"result\"\n",
         fixture("terrain-ramp-stereo.bin")
     );
     std::fs::write(d.join("lab.toml"), config).unwrap();

@@ -37,12 +37,39 @@ fn floor_is_floor_and_drivable_wall_is_not() {
 
     let wall = frame(dir.path(), "wall.ply", TerrainSpec::Wall { distance: 1.0, height: 2.0 });
     for res in ["45", "15", "9"] {
-        let o = patchnav(&["terrain", wall.to_str().unwrap(), "--resolution", res]);
+        let o = patchnav(&[
+            "terrain",
+            wall.to_str().unwrap(),
+            "--resolution",
+            res,
+            "--sensor-height",
+            "0.45",
+        ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let text = stdout(&o);
         assert_eq!(line(&text, "drivable:"), "drivable:  no", "at {res}°: {text}");
         assert_eq!(line(&text, "class:"), "class:     obstacle", "at {res}°: {text}");
     }
+}
+
+#[test]
+fn the_mount_is_estimated_from_the_frame_when_not_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let floor = frame(dir.path(), "floor.ply", TerrainSpec::Floor);
+    let o = patchnav(&["terrain", floor.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["class"], "floor");
+    let m = &v["mount"];
+    assert!((m["height_m"].as_f64().unwrap() - 0.45).abs() < 0.05, "{m}");
+    assert!(m["pitch_deg"].as_f64().unwrap().abs() < 1.0, "{m}");
+    assert!(m["estimated"]["inliers"].as_u64().unwrap() > 1000, "{m}");
+    let o = patchnav(&["terrain", floor.to_str().unwrap()]);
+    assert!(line(&stdout(&o), "mount:").contains("(estimated:"), "{}", stdout(&o));
+    // A wall 1 m ahead hides the floor from a level camera: no mount, and the error says how
+    // to give one.
+    let wall = frame(dir.path(), "wall.ply", TerrainSpec::Wall { distance: 1.0, height: 2.0 });
+    assert_one_line_error(&patchnav(&["terrain", wall.to_str().unwrap()]), "--sensor-height");
 }
 
 #[test]
