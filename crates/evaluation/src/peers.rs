@@ -105,27 +105,26 @@ pub fn planes(env: &Peers) -> Result<(Vec<Value>, String)> {
     let s = |p: &Path| p.display().to_string();
     let jsonl = work.join("ours.jsonl");
     let _ = std::fs::remove_file(&jsonl);
-    let mut runs = Vec::new();
-    for (cloud, k) in [("floorplan_scan", "30"), ("floorplan", "10")] {
-        let file = s(&bench.join(format!("{cloud}.ply")));
+    // Our extraction of `file` as `cloud`.
+    let ours = |cloud: &'static str, file: String| {
         let polys = work.join(format!("{cloud}.patchnav.polygons.json"));
-        runs.push(Run {
+        let command = [&s(patchnav), "extract", &file, "--sensor", "range-camera", "--jsonl"]
+            .into_iter()
+            .map(str::to_owned)
+            .chain([s(&jsonl), "--polygons".into(), s(&polys)])
+            .collect();
+        Run {
             cloud,
             tool: "patchnav",
             method: "region-growing",
-            command: Ok(vec![
-                s(patchnav),
-                "extract".into(),
-                file.clone(),
-                "--sensor".into(),
-                "range-camera".into(),
-                "--jsonl".into(),
-                s(&jsonl),
-                "--polygons".into(),
-                s(&polys),
-            ]),
+            command: Ok(command),
             polygons: polys,
-        });
+        }
+    };
+    let mut runs = Vec::new();
+    for (cloud, k) in [("floorplan_scan", "30"), ("floorplan", "10")] {
+        let file = s(&bench.join(format!("{cloud}.ply")));
+        runs.push(ours(cloud, file.clone()));
         for method in ["omps", "rg", "ransac"] {
             let dir = work.join(format!("{cloud}.pcl_{method}"));
             let mut cmd = vec![s(&pcl), file.clone(), "--method".into(), method.into()];
@@ -166,24 +165,7 @@ pub fn planes(env: &Peers) -> Result<(Vec<Value>, String)> {
     // from the start point (the same world points; only ours runs on this copy).
     let moved = work.join(format!("{VIEWPOINT_CLOUD}.ply"));
     write_viewpoint_copy(&bench.join("floorplan.ply"), &moved)?;
-    let polys = work.join(format!("{VIEWPOINT_CLOUD}.patchnav.polygons.json"));
-    runs.push(Run {
-        cloud: VIEWPOINT_CLOUD,
-        tool: "patchnav",
-        method: "region-growing",
-        command: Ok(vec![
-            s(patchnav),
-            "extract".into(),
-            s(&moved),
-            "--sensor".into(),
-            "range-camera".into(),
-            "--jsonl".into(),
-            s(&jsonl),
-            "--polygons".into(),
-            s(&polys),
-        ]),
-        polygons: polys,
-    });
+    runs.push(ours(VIEWPOINT_CLOUD, s(&moved)));
 
     eprintln!("ground truth: distinct planes of floorplan.obj, visible planes per cloud");
     let truth = Truth::load(&bench)?;
@@ -447,15 +429,8 @@ impl Truth {
 
     /// Quality of a run's polygons JSON on `cloud` (see the module docs).
     pub fn quality(&self, cloud: &str, polygons: &Value) -> Value {
-        let visible = self.visible(cloud);
-        let mut tally = MatchTally::new(self.planes.len());
-        for e in parse_planes(polygons) {
-            for q in &e.corners {
-                tally.vertex(self.nearest(q).is_some());
-            }
-            tally.plane(e.matches(&self.planes));
-        }
-        tally.report(visible, |i| {
+        let tally = MatchTally::of_polygons(polygons, &self.planes, |q| self.nearest(q).is_some());
+        tally.report(self.visible(cloud), |i| {
             let t = &self.planes[i];
             format!(
                 "n ({:.0} {:.0} {:.0}) · x = {:.2}",
@@ -619,6 +594,23 @@ impl MatchTally {
     /// A tally over `true_planes` true planes.
     pub fn new(true_planes: usize) -> MatchTally {
         MatchTally { found: vec![false; true_planes], off: 0, vertices: 0, on_surface: 0 }
+    }
+
+    /// The tally of a run's plane-polygon JSON against `truth`, a vertex counting as on a
+    /// surface where `on_surface` says so.
+    pub(crate) fn of_polygons(
+        polygons: &Value,
+        truth: &[Plane],
+        on_surface: impl Fn(&Point3) -> bool,
+    ) -> MatchTally {
+        let mut tally = MatchTally::new(truth.len());
+        for e in parse_planes(polygons) {
+            for q in &e.corners {
+                tally.vertex(on_surface(q));
+            }
+            tally.plane(e.matches(truth));
+        }
+        tally
     }
 
     /// One polygon vertex, on a true surface or not.

@@ -213,7 +213,22 @@ pub fn estimate_mount(points: &[Point3<f64>], search: &MountSearch) -> Result<Mo
             max_tilt_deg: search.max_tilt.to_degrees(),
         });
     };
-    for _ in 0..2 {
+    // Noisy frames (sunlit time of flight): widen the band to the residuals' robust spread
+    // (2.5 σ from the median absolute residual within 5 tolerances), at most 5 tolerances.
+    let mut tol = tol;
+    for round in 0..3 {
+        if round == 2 {
+            let mut r: Vec<f64> = pts
+                .iter()
+                .map(|p| ground.distance(p).abs())
+                .filter(|e| *e <= 5.0 * search.inlier_distance)
+                .collect();
+            if r.len() >= 3 {
+                r.sort_by(f64::total_cmp);
+                let sigma = 1.4826 * r[r.len() / 2];
+                tol = (2.5 * sigma).clamp(search.inlier_distance, 5.0 * search.inlier_distance);
+            }
+        }
         if let Some(g) = refit(&pts, &ground, tol)
             .filter(|g| accept(g) && spread(&pts, g, tol) >= search.min_spread)
         {

@@ -21,7 +21,7 @@ use pointcloud::{Point3, Vector3};
 use scene_sim::{Point2, Scene, Shape};
 use serde_json::Value;
 
-use crate::peers::{MatchTally, Plane, parse_planes};
+use crate::peers::{MatchTally, Plane};
 pub(crate) use crate::peers::{ON_SURFACE, VISIBLE_POINTS};
 
 /// Surfaces lie on one true plane within these (degrees, metres).
@@ -92,13 +92,7 @@ impl SceneTruth {
     /// The quality of a run's plane polygons with `visible` true planes, as the JSON object
     /// `peers::Truth::quality` gives (the same keys).
     pub(crate) fn quality(&self, visible: &[usize], polygons: &Value) -> Value {
-        let mut tally = MatchTally::new(self.planes.len());
-        for e in parse_planes(polygons) {
-            for q in &e.corners {
-                tally.vertex(self.on_surface(q));
-            }
-            tally.plane(e.matches(&self.planes));
-        }
+        let tally = MatchTally::of_polygons(polygons, &self.planes, |q| self.on_surface(q));
         tally.report(visible, |i| {
             let t = &self.planes[i];
             format!(
@@ -159,6 +153,7 @@ fn segment_distance(q: &Point2, a: &Point2, b: &Point2) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::peers::parse_planes;
     use pointcloud::Isometry3;
     use scene_sim::{Cuboid, Cylinder, Material, PlanarPolygon, SceneBuilder, Sphere};
     use serde_json::json;
