@@ -227,15 +227,12 @@ pub(crate) fn run() -> Result<Vec<Value>> {
                     "accepted": r.accepted, "points": r.points, "high_bins": r.high_bins,
                     "plane": r.plane.map(|p| json!({"rho_x_deg": p.rho_x.to_degrees(), "rho_y_deg": p.rho_y.to_degrees(), "d": p.d})),
                     "mount_height": f.height, "mount_pitch_deg": f.pitch_deg, "mount": f.mount_note,
-                "mount_used": mount_label,
+                    "mount_used": mount_label,
                 }));
             }
             table += &format!(
-                "| {} | {} / {} ({}) | {} | {} | {} |\n",
+                "| {} | {mount_label} | {} | {} | {} |\n",
                 f.name,
-                f.height,
-                f.pitch_deg,
-                f.mount_note,
                 points.len(),
                 cells.join(" | "),
                 times.join(" / ")
