@@ -6,11 +6,13 @@
 //! through three sampled points (RANSAC) whose normal is within [`MountSearch::max_tilt`] of the
 //! sensor's nominal up axis and which pass between [`MountSearch::min_height`] and
 //! [`MountSearch::max_height`] below the sensor, the search keeps the one with the most points
-//! within [`MountSearch::inlier_distance`] minus the points clearly below it (a table top or
-//! a plateau has the floor beneath it; the floor has nothing). The winner is refitted by least
-//! squares to its inliers, twice, near points weighted more (range noise grows with range).
-//! Height is the sensor's distance from that plane; pitch and roll are the tilt of its normal
-//! in the sensor's nominal body axes (x forward, y left, z up).
+//! within [`MountSearch::inlier_distance`] minus the points more than
+//! [`MountSearch::below_margin`] below it (a table top or a plateau has the floor beneath it;
+//! the floor has nothing). Its points must spread over an area ([`MountSearch::min_spread`]).
+//! The winner is refitted by least squares to its inliers, near points weighted more (range
+//! noise grows with range), the band widened to the residuals' spread on noisy frames. Height is
+//! the sensor's distance from that plane; pitch and roll are the tilt of its normal in the
+//! sensor's nominal body axes (x forward, y left, z up).
 //!
 //! One frame that shows mostly a ramp or a plateau calibrates to that surface: a robot should
 //! calibrate on frames of its ground, or keep a running median over many frames
@@ -39,6 +41,10 @@ pub struct MountSearch {
     pub max_range: f64,
     /// A point within this distance of a plane supports it, metres (default 0.04).
     pub inlier_distance: f64,
+    /// A point more than this below a plane counts against it, metres (default 0.25): a table
+    /// top or a plateau has the floor beneath it. Well above the range noise, so that the
+    /// floor's own noisy points do not count against the floor.
+    pub below_margin: f64,
     /// The ground's supporting points must spread at least this far (standard deviation,
     /// metres) in both directions of the plane (default 0.15): a band across a wall or the
     /// edge of a box top is no ground.
@@ -60,6 +66,7 @@ impl Default for MountSearch {
             max_height: 5.0,
             max_range: 30.0,
             inlier_distance: 0.04,
+            below_margin: 0.25,
             min_spread: 0.15,
             iterations: 400,
             max_points: 6000,
@@ -96,6 +103,9 @@ impl MountSearch {
         }
         if !(self.inlier_distance.is_finite() && self.inlier_distance > 0.0) {
             return bad("mount search inlier_distance", self.inlier_distance, "finite and > 0");
+        }
+        if !(self.below_margin.is_finite() && self.below_margin > 0.0) {
+            return bad("mount search below_margin", self.below_margin, "finite and > 0");
         }
         if !(self.min_spread.is_finite() && self.min_spread >= 0.0) {
             return bad("mount search min_spread", self.min_spread, "finite and ≥ 0");
@@ -183,7 +193,7 @@ pub fn estimate_mount(points: &[Point3<f64>], search: &MountSearch) -> Result<Mo
             let e = g.distance(p);
             if e.abs() <= tol {
                 s + 1
-            } else if e < -3.0 * tol {
+            } else if e < -search.below_margin {
                 s - 1
             } else {
                 s
@@ -412,6 +422,7 @@ mod tests {
             MountSearch { inlier_distance: f64::NAN, ..s },
             MountSearch { iterations: 0, ..s },
             MountSearch { min_spread: -1.0, ..s },
+            MountSearch { below_margin: 0.0, ..s },
         ] {
             assert!(matches!(
                 estimate_mount(&frame(0.5, 0.0, 0.0, SensorAxes::Body), &bad),
