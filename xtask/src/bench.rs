@@ -61,9 +61,6 @@ pub struct LabMapParams {
     pub scan_step_deg: Option<f64>,
 }
 
-/// The map types of the thesis's Table 6.1; `k.pmap` is the file of kind `k`.
-pub const LAB_MAP_KINDS: [MapKind; 4] = MapKind::ALL;
-
 impl Default for LabMapParams {
     /// `patchnav experiment lab-timing`'s defaults.
     fn default() -> LabMapParams {
@@ -198,7 +195,7 @@ pub fn lab_maps_fresh(dir: &Path, binary: &Path) -> bool {
     let (Some(built), Some(bin)) = (modified(&dir.join("build.json")), modified(binary)) else {
         return false;
     };
-    built >= bin && LAB_MAP_KINDS.iter().all(|k| dir.join(format!("{k}.pmap")).is_file())
+    built >= bin && MapKind::ALL.iter().all(|k| dir.join(format!("{k}.pmap")).is_file())
 }
 
 /// The folder of the lab's four maps from scans for `params`, built with the release
@@ -214,7 +211,7 @@ fn lab_maps(params: &LabMapParams) -> Result<PathBuf> {
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let _ = std::fs::remove_file(dir.join("build.json"));
     let mut commands = Vec::new();
-    for kind in LAB_MAP_KINDS {
+    for kind in MapKind::ALL {
         let t0 = std::time::Instant::now();
         let (tmp, out) = (dir.join(format!("{kind}.pmap.tmp")), dir.join(format!("{kind}.pmap")));
         let args = params.patchnav_args(kind, &tmp);
@@ -473,7 +470,7 @@ mod tests {
         };
         let now = SystemTime::now();
         touch(&binary, now - Duration::from_secs(60));
-        for k in LAB_MAP_KINDS {
+        for k in MapKind::ALL {
             touch(&maps.join(format!("{k}.pmap")), now);
         }
         assert!(!lab_maps_fresh(&maps, &binary), "no build.json: interrupted");

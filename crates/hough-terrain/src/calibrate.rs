@@ -184,7 +184,7 @@ pub fn estimate_mount(points: &[Point3<f64>], search: &MountSearch) -> Result<Mo
     if pts.len() < 3 {
         return Err(HoughError::NotEnoughPoints { got: pts.len(), need: 3 });
     }
-    let tol = search.inlier_distance;
+    let mut tol = search.inlier_distance;
     let min_up = search.max_tilt.cos();
     let accept =
         |g: &Ground| g.n.z >= min_up && (search.min_height..=search.max_height).contains(&g.d);
@@ -223,28 +223,22 @@ pub fn estimate_mount(points: &[Point3<f64>], search: &MountSearch) -> Result<Mo
             max_tilt_deg: search.max_tilt.to_degrees(),
         });
     };
+    let refine = |ground: Ground, tol: f64| {
+        refit(&pts, &ground, tol)
+            .filter(|g| accept(g) && spread(&pts, g, tol) >= search.min_spread)
+            .unwrap_or(ground)
+    };
+    ground = refine(refine(ground, tol), tol);
     // Noisy frames (sunlit time of flight): widen the band to the residuals' robust spread
     // (2.5 σ from the median absolute residual within 5 tolerances), at most 5 tolerances.
-    let mut tol = tol;
-    for round in 0..3 {
-        if round == 2 {
-            let mut r: Vec<f64> = pts
-                .iter()
-                .map(|p| ground.distance(p).abs())
-                .filter(|e| *e <= 5.0 * search.inlier_distance)
-                .collect();
-            if r.len() >= 3 {
-                r.sort_by(f64::total_cmp);
-                let sigma = 1.4826 * r[r.len() / 2];
-                tol = (2.5 * sigma).clamp(search.inlier_distance, 5.0 * search.inlier_distance);
-            }
-        }
-        if let Some(g) = refit(&pts, &ground, tol)
-            .filter(|g| accept(g) && spread(&pts, g, tol) >= search.min_spread)
-        {
-            ground = g;
-        }
+    let wide = 5.0 * search.inlier_distance;
+    let mut r: Vec<f64> =
+        pts.iter().map(|p| ground.distance(p).abs()).filter(|e| *e <= wide).collect();
+    if r.len() >= 3 {
+        r.sort_by(f64::total_cmp);
+        tol = (2.5 * 1.4826 * r[r.len() / 2]).clamp(search.inlier_distance, wide);
     }
+    ground = refine(ground, tol);
     let inliers: Vec<f64> =
         pts.iter().map(|p| ground.distance(p)).filter(|e| e.abs() <= tol).collect();
     let rms = (inliers.iter().map(|e| e * e).sum::<f64>() / inliers.len().max(1) as f64).sqrt();

@@ -140,22 +140,19 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         AxesChoice::Lidar => SensorAxes::Body,
         AxesChoice::Camera => SensorAxes::Optical,
     };
-    let estimated = match args.sensor_height {
-        Some(_) => None,
+    let (height, pitch, roll, estimated) = match args.sensor_height {
+        Some(h) => (h, args.pitch.unwrap_or(0.0).to_radians(), 0.0, None),
         None => {
-            Some(estimate_mount(cloud.positions(), &MountSearch::new(sensor_axes)).with_context(
-                || {
+            let e = estimate_mount(cloud.positions(), &MountSearch::new(sensor_axes))
+                .with_context(|| {
                     format!(
                         "{}: estimating the sensor's mount (give --sensor-height and --pitch)",
                         args.frame.display()
                     )
-                },
-            )?)
+                })?;
+            (e.height, args.pitch.map_or(e.pitch, f64::to_radians), e.roll, Some(e))
         }
     };
-    let height = args.sensor_height.or(estimated.map(|e| e.height)).context("a height")?;
-    let pitch = args.pitch.map(f64::to_radians).or(estimated.map(|e| e.pitch)).unwrap_or(0.0);
-    let roll = estimated.map_or(0.0, |e| e.roll);
     let mount = SensorMount::looking_ahead(height, pitch, roll, sensor_axes)?;
     let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
     let cut = args.max_range.is_some() || axes == AxesChoice::Lidar;

@@ -174,8 +174,8 @@ pub(crate) fn run() -> Result<Vec<Value>> {
             )),
             Err(why) => eprintln!("{}: no mount estimate: {why}", f.name),
         }
+        let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
         for (mount, mount_label, suffix) in mounts {
-            let frame_pixels = cloud.grid().map_or(cloud.len(), |g| g.num_pixels());
             let (points, pixels) = match f.max_range {
                 Some(r) => {
                     let p = forward_view(cloud.positions(), &mount, r);
