@@ -66,6 +66,7 @@
 //! | beyond: per-sector classification | [`SectorClassifier`], [`SectorGrid`] |
 //! | beyond: equal-area ball accumulator (Borrmann et al. 2011) | [`BallAccumulator`], [`refine_plane`] |
 //! | beyond: mount self-calibration (height, pitch, roll from the ground plane; one frame or a running window) | [`estimate_mount`], [`MountSearch`], [`MountWindow`] |
+//! | beyond: per-point ground segmentation (local planes on a polar grid, Rugbot's step and slope limits) | [`GroundSegmenter`], [`GroundSettings`] |
 //!
 //! # Conventions
 //!
@@ -111,6 +112,7 @@ pub mod calibrate;
 pub mod classifier;
 pub mod classify;
 pub mod error;
+pub mod ground;
 pub mod histogram;
 pub mod mount;
 pub mod sectors;
@@ -125,6 +127,7 @@ pub use classify::{
     Thresholds, algorithm3, bin_type, floor_bin,
 };
 pub use error::{HoughError, Result};
+pub use ground::{GroundSegmenter, GroundSettings, GroundSummary};
 pub use histogram::{HistogramStyle, hough_image, hough_png, hough_png_file};
 pub use mount::{SensorAxes, SensorMount};
 pub use sectors::{Sector, SectorClassifier, SectorGrid};
