@@ -297,12 +297,20 @@ pub(crate) fn real_data_dir() -> Option<std::path::PathBuf> {
 
 fn tof(seed: u64) -> Result<Vec<Value>> {
     use sensor_tof::experiment::{
-        Method, evaluate_folded, evaluate_scene, quality_table, table_2_4,
+        Method, evaluate_folded, evaluate_scene, quality_table, table_2_4, tune_on_scenes,
+        yield_table,
     };
     let mut rows = Vec::new();
     let mut results = Vec::new();
+    // Region unwrapping is tuned on the next seed and scored on this one.
+    let tuned = tune_on_scenes(seed + 1)?;
+    let mut methods = Method::all();
+    methods.push(Method::Regions(Box::new(tuned.config.clone())));
     for scene in sensor_tof::scenes::all_scenes()? {
-        let r = evaluate_scene(&scene, &Method::all(), seed)?;
+        let mut r = evaluate_scene(&scene, &methods, seed)?;
+        if let Some(m) = r.results.last_mut() {
+            m.method = "regions (tuned)".into();
+        }
         for m in &r.results {
             let q = &m.score;
             for (metric, value, unit) in [
@@ -312,11 +320,13 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
                 ("wrapped_kept", q.wrapped_kept_percent, "%"),
                 ("unwrapped_correct", q.unwrapped_correct_percent, "%"),
                 ("correct", q.correct_percent, "%"),
+                ("yield", q.yield_percent, "%"),
                 ("rmse_correct", q.rmse_correct * 100.0, "cm"),
             ] {
                 rows.push(json!({
                     "case": format!("{}/{}", r.scene, m.method), "metric": metric, "value": value,
                     "unit": unit, "seed": seed, "wrapped_percent": r.wrapped_percent,
+                    "recoverable_percent": r.recoverable_percent,
                     "thesis_aat": r.thesis.aat, "thesis_at160": r.thesis.at160, "thesis_at240": r.thesis.at240,
                 }));
             }
@@ -325,8 +335,17 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
     }
     eprintln!("{}", table_2_4(&results));
     eprintln!("{}", quality_table(&results));
+    eprintln!(
+        "region unwrapping tuned on seed {} (training: mean yield {:.1} %, worst wrong {:.2} %): {:?}",
+        seed + 1,
+        tuned.train_yield_percent,
+        tuned.train_max_wrong_percent,
+        tuned.config
+    );
+    eprintln!("{}", yield_table(&results));
 
-    // The real ifm O3R frame (0.2–2 m, median 0.51 m): distances folded at 0.5 m (second frequency 0.6 m).
+    // The real ifm O3R frame (0.2–2 m, median 0.51 m): distances folded at 0.5 m and at 0.7 m
+    // (second frequency 1.2 times further), tuned on the even rows, scored on the odd rows.
     match real_data_dir().map(|d| d.join("ifm_o3r_tof_frame")) {
         Some(dir) if dir.is_dir() => {
             let meta = sensor_tof::io::read_meta(&dir.join("frame_meta.json"))?;
@@ -340,34 +359,34 @@ fn tof(seed: u64) -> Result<Vec<Value>> {
                 &dir.join("normalized_amplitude_u16.png"),
                 &meta,
             )?;
-            let f = evaluate_folded(&frame, Some(noise.range()), 0.5, 0.6, seed)?;
-            eprintln!(
-                "ifm O3R frame folded at {} m (second frequency {} m): {} measured pixels, {:.1} % wrapped; \
-                 thresholds tuned on the even rows: {:?}; scored on the odd rows:",
-                f.fold_m, f.second_fold_m, f.measured, f.wrapped_percent, f.thresholds
-            );
-            let wrapped = sensor_tof::experiment::SceneResult {
-                scene: "ifm-folded".into(),
-                wrapped_percent: f.wrapped_percent,
-                thesis: sensor_tof::experiment::ThesisDiscarded {
-                    aat: f64::NAN,
-                    at160: f64::NAN,
-                    at240: None,
-                },
-                results: f.results.clone(),
-            };
-            eprintln!("{}", quality_table(std::slice::from_ref(&wrapped)));
-            for m in &f.results {
-                for (metric, value) in [
-                    ("discarded", m.score.discarded_percent),
-                    ("wrong_kept", m.score.wrong_kept_percent),
-                    ("unwrapped_correct", m.score.unwrapped_correct_percent),
-                    ("correct", m.score.correct_percent),
-                ] {
-                    rows.push(json!({
-                        "case": format!("ifm-folded-0.5m/{}", m.method), "metric": metric, "value": value,
-                        "unit": "%", "seed": seed,
-                    }));
+            for fold in [0.5, 0.7] {
+                let f = evaluate_folded(&frame, Some(noise.range()), fold, 1.2 * fold, seed)?;
+                eprintln!(
+                    "ifm O3R frame folded at {} m (second frequency {} m): {} measured pixels, {:.1} % wrapped; \
+                     thresholds tuned on the even rows: {:?}; regions tuned on the even rows: {:?}; scored on the odd rows:",
+                    f.fold_m,
+                    f.second_fold_m,
+                    f.measured,
+                    f.wrapped_percent,
+                    f.thresholds,
+                    f.regions.config
+                );
+                let as_scene = f.as_scene();
+                eprintln!("{}", quality_table(std::slice::from_ref(&as_scene)));
+                eprintln!("{}", yield_table(std::slice::from_ref(&as_scene)));
+                for m in &f.results {
+                    for (metric, value) in [
+                        ("discarded", m.score.discarded_percent),
+                        ("wrong_kept", m.score.wrong_kept_percent),
+                        ("unwrapped_correct", m.score.unwrapped_correct_percent),
+                        ("correct", m.score.correct_percent),
+                        ("yield", m.score.yield_percent),
+                    ] {
+                        rows.push(json!({
+                            "case": format!("ifm-folded-{fold}m/{}", m.method), "metric": metric, "value": value,
+                            "unit": "%", "seed": seed, "recoverable_percent": f.recoverable_percent,
+                        }));
+                    }
                 }
             }
         }

@@ -755,13 +755,15 @@ fn section_tof(t: Option<&TofSection>) -> String {
         }
         format!(
             " Here {} on the simulated {} scene discards {} % of the pixels; {} % of the pixels were \
-             wrapped, {} % of those are put back within 5 cm, and {} % of the output is wrong.",
+             wrapped, {} % of those are put back within 5 cm, {} % of the output is wrong, and the \
+             yield (correct output pixels per measured pixel) is {} %.",
             t.method,
             t.scene,
             fixed(t.discarded_percent, 1),
             fixed(t.wrapped_percent, 1),
             fixed(t.unwrapped_correct_percent, 1),
-            fixed(t.wrong_percent, 2)
+            fixed(t.wrong_percent, 2),
+            fixed(t.yield_percent, 1)
         )
     });
     out.push_str(&caption(&format!(
@@ -826,7 +828,16 @@ fn section_tof(t: Option<&TofSection>) -> String {
         },
     }
     out.push_str(&table(
-        &["scene", "method", "discarded", "wrapped", "unwrapped correctly", "wrong", "time"],
+        &[
+            "scene",
+            "method",
+            "discarded",
+            "wrapped",
+            "unwrapped correctly",
+            "wrong",
+            "yield",
+            "time",
+        ],
         &[vec![
             t.scene.clone(),
             t.method.clone(),
@@ -834,6 +845,7 @@ fn section_tof(t: Option<&TofSection>) -> String {
             format!("{} %", fixed(t.wrapped_percent, 1)),
             format!("{} %", fixed(t.unwrapped_correct_percent, 1)),
             format!("{} %", fixed(t.wrong_percent, 2)),
+            format!("{} %", fixed(t.yield_percent, 1)),
             format!("{} ms", sig(t.millis, 3)),
         ]],
     ));
@@ -929,6 +941,7 @@ mod tests {
                 wrapped_percent: 12.0,
                 unwrapped_correct_percent: 97.5,
                 wrong_percent: 0.31,
+                yield_percent: 80.5,
                 millis: 1.9,
             }),
             terrain: Some(TerrainSection {

@@ -104,6 +104,9 @@ pub struct TofSection {
     pub unwrapped_correct_percent: f64,
     /// % of output pixels that are wrong.
     pub wrong_percent: f64,
+    /// Correct output pixels, % of the measured pixels (the yield; NaN without a truth).
+    #[serde(default = "nan")]
+    pub yield_percent: f64,
     /// Filter time, milliseconds.
     pub millis: f64,
 }
@@ -317,4 +320,9 @@ pub struct FileEntry {
     pub path: String,
     /// Size, bytes.
     pub bytes: u64,
+}
+
+/// NaN: the serde default of a figure an older `results.json` lacks.
+fn nan() -> f64 {
+    f64::NAN
 }

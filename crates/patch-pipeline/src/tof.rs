@@ -11,8 +11,11 @@ use sensor_tof::io::{
     DEFAULT_AAT, FrameMeta, frame_from_cloud, read_json, read_meta, read_png_pair,
     read_png_pair_with_confidence,
 };
+use sensor_tof::regions::{RegionConfig, RegionUnwrapper};
 use sensor_tof::two_freq::{TwoFreqConfig, unwrap_two_frequencies};
-use sensor_tof::{AatRange, FilterConfig, FilterOutput, NegativeIllumination, TofFilter, TofFrame};
+use sensor_tof::{
+    AatConfig, AatRange, FilterConfig, FilterOutput, NegativeIllumination, TofFilter, TofFrame,
+};
 use std::path::{Path, PathBuf};
 
 /// The frame to read: a PNG pair, or an organised cloud, with its sidecar.
@@ -40,6 +43,10 @@ crate::names::named_enum! {
         /// Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`).
         TwoFreq = "two-freq",
             "Two frames at two modulation frequencies (`--range2`, `--amplitude2`, `--meta2`)";
+        /// Region unwrapping (beyond the thesis): the AAT's evidence judged per smooth region;
+        /// unwraps only where the region agrees, drops the ambiguous rest.
+        Regions = "regions",
+            "Region unwrapping: unwrap only where a smooth region's ranges and amplitudes agree, drop the ambiguous rest";
     }
 }
 
@@ -64,7 +71,8 @@ pub struct FilterSetup {
     /// Unwrap the pixels the AAT flags (one non-ambiguity range further along the beam).
     pub unwrap: bool,
     /// With `--unwrap`: drop instead of unwrapping flagged pixels with amplitude ≤ X (very
-    /// dark, probably wrapped more than once).
+    /// dark, probably wrapped more than once); with `--method regions`: drop pixels with
+    /// amplitude ≤ X before segmenting (`RegionConfig::low_at`).
     pub low_at: Option<Real>,
     /// Use the radial distance as Eq 2.4's r_p (default: the depth, as the thesis).
     pub radial: bool,
@@ -125,45 +133,10 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
             (f.run(&frame)?, format!("AT {}", args.at))
         }
         Method::Aat => {
-            let mut aat = match &args.calibration {
-                Some(path) => {
-                    let c: Calibration = read_json(path)?;
-                    let (w, h) = (frame.camera().width, frame.camera().height);
-                    if (c.width, c.height) != (w, h) {
-                        bail!(
-                            "{}: calibrated on {} × {} frames, this one is {w} × {h}",
-                            path.display(),
-                            c.width,
-                            c.height
-                        );
-                    }
-                    // The sidecar's threshold (else the thesis's 0.2) with this illumination.
-                    let threshold = meta.aat()?.map_or(DEFAULT_AAT, |a| a.threshold);
-                    c.aat_config(threshold)
-                }
-                None => meta.aat()?.with_context(|| {
-                    format!(
-                        "{}: no AAT parameters (give an `aat` block or a camera preset, or \
-                         --calibration)",
-                        args.frame.meta.display()
-                    )
-                })?,
-            };
-            if let Some(t) = args.aat {
-                aat.threshold = t;
+            if args.low_at.is_some() && !args.unwrap {
+                bail!("--low-at needs --unwrap with --method aat (or --method regions)");
             }
-            if args.radial {
-                aat.range = AatRange::Radial;
-            }
-            if let Some(fraction) = args.clamp_corners {
-                if !(fraction.is_finite() && fraction > 0.0 && fraction <= 1.0) {
-                    bail!("--clamp-corners {fraction}: want a fraction in (0, 1]");
-                }
-                let aw = sensor_tof::filter::illumination_table(&aat.illumination, frame.camera())?;
-                let max = aw.iter().copied().fold(Real::NEG_INFINITY, Real::max);
-                aat.negative =
-                    NegativeIllumination::Clamp((fraction * max).max(Real::MIN_POSITIVE));
-            }
+            let aat = aat_of(args, &frame, &meta)?;
             let name = format!("AAT {}", aat.threshold);
             let config = if args.unwrap {
                 FilterConfig::aat_unwrap(aat, args.low_at)
@@ -171,6 +144,18 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
                 FilterConfig::aat(aat)
             };
             (TofFilter::new(frame.camera(), frame.kind(), &config)?.run(&frame)?, name)
+        }
+        Method::Regions => {
+            if args.unwrap {
+                bail!(
+                    "--unwrap is for --method aat: --method regions decides what to unwrap itself"
+                );
+            }
+            let aat = aat_of(args, &frame, &meta)?;
+            let name = format!("regions (AAT {})", aat.threshold);
+            let config = RegionConfig { low_at: args.low_at, ..RegionConfig::new(aat) };
+            let out = RegionUnwrapper::new(frame.camera(), frame.kind(), &config)?.run(&frame)?;
+            (out, name)
         }
         Method::TwoFreq => {
             let (Some(r2), Some(a2), Some(m2)) = (&args.range2, &args.amplitude2, &args.meta2)
@@ -197,4 +182,48 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
         }
     };
     Ok((frame, output, name))
+}
+
+/// The AAT of `--method aat` and `--method regions`: the calibration's illumination or the
+/// sidecar's AAT, with `--aat`, `--radial` and `--clamp-corners` applied.
+fn aat_of(args: &FilterSetup, frame: &TofFrame, meta: &FrameMeta) -> Result<AatConfig> {
+    let mut aat = match &args.calibration {
+        Some(path) => {
+            let c: Calibration = read_json(path)?;
+            let (w, h) = (frame.camera().width, frame.camera().height);
+            if (c.width, c.height) != (w, h) {
+                bail!(
+                    "{}: calibrated on {} × {} frames, this one is {w} × {h}",
+                    path.display(),
+                    c.width,
+                    c.height
+                );
+            }
+            // The sidecar's threshold (else the thesis's 0.2) with this illumination.
+            let threshold = meta.aat()?.map_or(DEFAULT_AAT, |a| a.threshold);
+            c.aat_config(threshold)
+        }
+        None => meta.aat()?.with_context(|| {
+            format!(
+                "{}: no AAT parameters (give an `aat` block or a camera preset, or \
+                 --calibration)",
+                args.frame.meta.display()
+            )
+        })?,
+    };
+    if let Some(t) = args.aat {
+        aat.threshold = t;
+    }
+    if args.radial {
+        aat.range = AatRange::Radial;
+    }
+    if let Some(fraction) = args.clamp_corners {
+        if !(fraction.is_finite() && fraction > 0.0 && fraction <= 1.0) {
+            bail!("--clamp-corners {fraction}: want a fraction in (0, 1]");
+        }
+        let aw = sensor_tof::filter::illumination_table(&aat.illumination, frame.camera())?;
+        let max = aw.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        aat.negative = NegativeIllumination::Clamp((fraction * max).max(Real::MIN_POSITIVE));
+    }
+    Ok(aat)
 }

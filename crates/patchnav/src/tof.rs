@@ -1,7 +1,7 @@
 //! `patchnav tof filter|calibrate`: time-of-flight frames (thesis §2.5.5; `sensor_tof`).
 //!
 //! ```text
-//! patchnav tof filter --range R.png --amplitude A.png --meta M.json --method aat|at|two-freq
+//! patchnav tof filter --range R.png --amplitude A.png --meta M.json --method regions|aat|at|two-freq
 //!     [--at 160] [--aat 0.2] [--calibration C.json] [--unwrap] [--low-at X] [--radial]
 //!     [--clamp-corners] [--range2 R2.png --amplitude2 A2.png --meta2 M2.json]
 //!     --out cloud.ply [--png outcomes.png] [--dense|--safe]
@@ -74,7 +74,7 @@ pub struct FilterArgs {
     #[arg(long, conflicts_with_all = ["range", "amplitude", "confidence"])]
     pub cloud: Option<PathBuf>,
     /// The filter.
-    #[arg(long, value_parser = crate::names::all::<Method>(), default_value_t = Method::Aat)]
+    #[arg(long, value_parser = crate::names::all::<Method>(), default_value_t = Method::Regions)]
     pub method: Method,
     /// The plain amplitude threshold of `--method at` (the thesis's baselines: 160 and 240).
     #[arg(long, default_value_t = 160.0)]
@@ -89,9 +89,10 @@ pub struct FilterArgs {
     /// Unwrap the pixels the AAT flags (one non-ambiguity range further along the beam).
     #[arg(long)]
     pub unwrap: bool,
-    /// With `--unwrap`: drop instead of unwrapping flagged pixels with amplitude ≤ X (very
-    /// dark, probably wrapped more than once).
-    #[arg(long, requires = "unwrap")]
+    /// With `--method aat --unwrap`: drop instead of unwrapping flagged pixels with amplitude
+    /// ≤ X (very dark, probably wrapped more than once); with `--method regions`: drop pixels
+    /// with amplitude ≤ X before segmenting.
+    #[arg(long)]
     pub low_at: Option<Real>,
     /// Use the radial distance as Eq 2.4's r_p (default: the depth, as the thesis).
     #[arg(long)]

@@ -44,6 +44,10 @@ pub struct Score {
     /// Correct output pixels, % of the measured pixels whose truth is known: density of good
     /// data.
     pub correct_percent: Real,
+    /// Correct output pixels, % of the measured pixels (those with a range, whether or not a
+    /// true surface is known): the yield.
+    #[serde(default)]
+    pub yield_percent: Real,
 }
 
 /// Scores `out` against `truth`: a pixel is correct iff it is output within `tolerance`
@@ -74,6 +78,7 @@ pub fn score(
     let mut s = Score { pixels: n, ..Score::default() };
     let (mut dropped, mut wrong, mut wrapped_kept, mut unwrapped_ok, mut correct, mut known) =
         (0, 0, 0, 0, 0, 0);
+    let n_measured = measured.iter().filter(|&&m| m).count();
     let mut gross = 0usize;
     let (mut se_all, mut n_all, mut se_ok) = (0.0, 0usize, 0.0);
     #[allow(clippy::needless_range_loop)] // five parallel arrays
@@ -120,9 +125,36 @@ pub fn score(
     s.gross_percent = pct(gross, s.output);
     s.unwrapped_correct_percent = pct(unwrapped_ok, s.wrapped);
     s.correct_percent = pct(correct, known);
+    s.yield_percent = pct(correct, n_measured);
     s.rmse_output = if n_all == 0 { 0.0 } else { (se_all / n_all as Real).sqrt() };
     s.rmse_correct = if correct == 0 { 0.0 } else { (se_ok / correct as Real).sqrt() };
     Ok(s)
+}
+
+/// The most any single-frame unwrapping can output correctly: the % of measured pixels (range
+/// `reported` > 0, radial metres) whose reported range plus some number `k ≤ max_wraps` of
+/// non-ambiguity ranges `non_ambiguity` lies within `tolerance` of the truth. Pixels without a
+/// true surface (noise) and pixels whose error is not wrap-around (scattering, noise beyond the
+/// tolerance) are not recoverable.
+pub fn recoverable_percent(
+    reported: &[f32],
+    truth: &FrameTruth,
+    non_ambiguity: Real,
+    max_wraps: u8,
+    tolerance: Real,
+) -> Real {
+    let (mut measured, mut ok) = (0usize, 0usize);
+    for (i, &r) in reported.iter().enumerate() {
+        if r <= 0.0 {
+            continue;
+        }
+        measured += 1;
+        let Some(t) = truth.radial.get(i).copied().flatten() else { continue };
+        let k = ((t as Real - r as Real) / non_ambiguity).round().max(0.0);
+        let e = (r as Real + k * non_ambiguity - t as Real).abs();
+        ok += (k <= max_wraps as Real && e <= tolerance) as usize;
+    }
+    if measured == 0 { 0.0 } else { 100.0 * ok as Real / measured as Real }
 }
 
 #[cfg(test)]
@@ -148,8 +180,24 @@ mod tests {
         assert_eq!(s.wrapped_kept_percent, 25.0);
         assert_eq!(s.gross_percent, 50.0); // pixel 1 (7.5 m off) and 4 (no surface)
         assert_eq!(s.wrapped, 3);
+        assert_eq!(s.yield_percent, 40.0); // pixels 0 and 2 of 5 measured
         assert!((s.unwrapped_correct_percent - 100.0 / 3.0).abs() < 1e-9);
         assert!((s.rmse_correct - ((0.01f64.powi(2) + 0.02f64.powi(2)) / 2.0).sqrt()).abs() < 1e-6);
         assert!(score(&out, &[true; 4], &truth, 0.05).is_err());
+    }
+
+    #[test]
+    fn recoverable_counts_wrap_multiples() {
+        let truth = FrameTruth {
+            radial: vec![Some(1.0), Some(8.52), Some(16.0), Some(3.0), None, Some(2.0)],
+            wraps: vec![0, 1, 2, 0, 0, 0],
+        };
+        // 1.0 as is; 1.0 + 7.5 within 5 cm of 8.52; 1.0 + 15 ≠ 16; 2.8 is 20 cm off; no truth.
+        let reported = [1.0, 1.0, 1.0, 2.8, 4.0, 0.0];
+        let p = recoverable_percent(&reported, &truth, 7.5, 1, 0.05);
+        assert!((p - 40.0).abs() < 1e-9, "{p}");
+        let truth2 = FrameTruth { radial: vec![Some(16.0)], wraps: vec![2] };
+        assert_eq!(recoverable_percent(&[1.0], &truth2, 7.5, 1, 0.05), 0.0);
+        assert_eq!(recoverable_percent(&[1.0], &truth2, 7.5, 2, 0.05), 100.0);
     }
 }

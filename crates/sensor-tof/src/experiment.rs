@@ -6,13 +6,14 @@
 //!
 //! `cargo xtask bench tof` runs it and prints [`table_2_4`] and [`quality_table`].
 
+use crate::regions::{RegionConfig, RegionUnwrapper};
 use crate::scenes::TofScene;
 use crate::sim::{SimulatedFrame, TofSimulator};
 use crate::spatial::{SpatialConfig, reconsider};
 use crate::two_freq::{TwoFreqConfig, TwoFreqUnwrapper};
 use crate::{
     AatConfig, FilterConfig, FilterOutput, FrameTruth, Illumination, Score, TofCamera, TofError,
-    TofFilter, TofFrame, score,
+    TofFilter, TofFrame, eval::recoverable_percent, score,
 };
 use pointcloud::{RangeKind, Real};
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,9 @@ pub enum Method {
     },
     /// Two-frequency unwrapping (the frame and a second one at the configured frequency).
     TwoFreq,
+    /// Region unwrapping ([`crate::regions`]) with these parameters; its `aat` is replaced by
+    /// the experiment's AAT (the camera's illumination, or the tuned flat one of a real frame).
+    Regions(Box<RegionConfig>),
 }
 
 impl Method {
@@ -67,7 +71,13 @@ impl Method {
             Method::AatUnwrapLowAt(20.0),
             Method::TwoFreq,
             Method::AatUnwrapSpatial { low_at: Some(20.0), isolation_support: 3 },
+            Method::regions(),
         ]
+    }
+
+    /// Region unwrapping with the defaults of [`RegionConfig::new`].
+    pub fn regions() -> Method {
+        Method::Regions(Box::new(RegionConfig::new(AatConfig::sr3000())))
     }
 
     /// A short column name.
@@ -95,6 +105,7 @@ impl Method {
                 }
             ),
             Method::TwoFreq => "two-freq".into(),
+            Method::Regions(_) => "regions".into(),
         }
     }
 }
@@ -130,6 +141,14 @@ pub struct SceneResult {
     pub wrapped_percent: Real,
     /// The thesis's figures.
     pub thesis: ThesisDiscarded,
+    /// The ceiling of any single-frame unwrapping that unwraps at most once: % of the measured
+    /// pixels that some wrap count 0 or 1 puts within [`TOLERANCE_M`] of the truth
+    /// ([`crate::eval::recoverable_percent`]).
+    #[serde(default)]
+    pub recoverable_percent: Real,
+    /// The same with any wrap count.
+    #[serde(default)]
+    pub recoverable_any_percent: Real,
     /// One entry per method, in the order asked.
     pub results: Vec<MethodResult>,
 }
@@ -200,7 +219,10 @@ pub fn evaluate_scene(
         .map(|m| run_method(m, &a.frame, b.as_ref().map(|b| &b.frame), &aat, &two, &a.truth))
         .collect::<Result<Vec<_>, _>>()?;
     let wrapped = a.truth.wraps.iter().filter(|&&w| w > 0).count();
+    let (recoverable_percent, recoverable_any_percent) = ceilings(&a.frame, &a.truth);
     Ok(SceneResult {
+        recoverable_percent,
+        recoverable_any_percent,
         scene: scene.name.to_string(),
         wrapped_percent: 100.0 * wrapped as Real / a.truth.wraps.len().max(1) as Real,
         thesis: ThesisDiscarded {
@@ -210,6 +232,177 @@ pub fn evaluate_scene(
         },
         results,
     })
+}
+
+/// The wrong-output limit [`tune_regions`] tunes for, % of the output (the 1 %).
+pub const WRONG_LIMIT_PERCENT: Real = 1.0;
+
+/// The parameter values [`tune_regions`] tries (every combination), each field a list of
+/// values of the [`RegionConfig`] field of the same name.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RegionGrid {
+    /// [`RegionConfig::max_brightness`].
+    pub max_brightness: Vec<Real>,
+    /// [`RegionConfig::max_amplitude_ratio`].
+    pub max_amplitude_ratio: Vec<Real>,
+    /// [`RegionConfig::min_margin`].
+    pub min_margin: Vec<Real>,
+    /// [`RegionConfig::max_wraps`].
+    pub max_wraps: Vec<u8>,
+    /// [`RegionConfig::low_at`].
+    pub low_at: Vec<Option<Real>>,
+    /// [`RegionConfig::max_noise_m`].
+    pub max_noise_m: Vec<Option<Real>>,
+    /// [`RegionConfig::join_curvature_m`].
+    pub join_curvature_m: Vec<Option<Real>>,
+}
+
+impl RegionGrid {
+    /// The grid for the simulated SR-3000/3100 scenes (amplitudes in the simulator's units).
+    pub fn simulated() -> RegionGrid {
+        RegionGrid {
+            max_brightness: vec![6.0, 10.0],
+            max_amplitude_ratio: vec![2.0, 3.0],
+            min_margin: vec![0.2],
+            max_wraps: vec![1],
+            low_at: vec![None, Some(100.0), Some(200.0)],
+            max_noise_m: vec![None, Some(0.02)],
+            join_curvature_m: vec![None, Some(0.02)],
+        }
+    }
+
+    /// The grid for a real frame folded at a short non-ambiguity range (ranges of a few
+    /// non-ambiguity ranges, millimetre noise: no amplitude floor or noise gate).
+    pub fn folded() -> RegionGrid {
+        RegionGrid {
+            max_brightness: vec![4.0, 6.0, 10.0, 16.0],
+            max_amplitude_ratio: vec![1.5, 3.0],
+            min_margin: vec![0.2, 0.5],
+            max_wraps: vec![1, 3],
+            low_at: vec![None],
+            max_noise_m: vec![None],
+            join_curvature_m: vec![Some(0.005), Some(0.02)],
+        }
+    }
+
+    /// Every combination, each on a copy of `base`.
+    pub fn configs(&self, base: &RegionConfig) -> Vec<RegionConfig> {
+        let mut v = Vec::new();
+        for &b in &self.max_brightness {
+            for &r in &self.max_amplitude_ratio {
+                for &m in &self.min_margin {
+                    for &k in &self.max_wraps {
+                        for &l in &self.low_at {
+                            for (&n, &c) in self
+                                .max_noise_m
+                                .iter()
+                                .flat_map(|n| self.join_curvature_m.iter().map(move |c| (n, c)))
+                            {
+                                v.push(RegionConfig {
+                                    join_curvature_m: c,
+                                    max_brightness: b,
+                                    max_amplitude_ratio: r,
+                                    min_margin: m,
+                                    max_wraps: k,
+                                    low_at: l,
+                                    max_noise_m: n,
+                                    ..base.clone()
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        v
+    }
+}
+
+/// What [`tune_regions`] chose and how it did on the training frames.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TunedRegions {
+    /// The chosen parameters (`aat` as in the base).
+    pub config: RegionConfig,
+    /// Mean yield over the training frames, %.
+    pub train_yield_percent: Real,
+    /// Largest wrong % of output over the training frames.
+    pub train_max_wrong_percent: Real,
+    /// Whether some combination kept every training frame at or below [`WRONG_LIMIT_PERCENT`].
+    pub within_limit: bool,
+}
+
+/// One training frame of [`tune_regions`]: the frame, its truth and its AAT.
+pub type TrainingFrame = (TofFrame, FrameTruth, AatConfig);
+
+/// Chooses region-unwrapping parameters on training frames: among the combinations of `grid`
+/// (on `base`) that keep the wrong output of every frame at or below [`WRONG_LIMIT_PERCENT`],
+/// the one with the highest mean yield; if none does, the one with the smallest largest wrong
+/// share (ties: higher yield).
+pub fn tune_regions(
+    frames: &[TrainingFrame],
+    base: &RegionConfig,
+    grid: &RegionGrid,
+) -> Result<TunedRegions, TofError> {
+    let mut best: Option<TunedRegions> = None;
+    for config in grid.configs(base) {
+        let (mut yield_sum, mut worst) = (0.0, 0.0 as Real);
+        for (frame, truth, aat) in frames {
+            let c = RegionConfig { aat: aat.clone(), ..config.clone() };
+            let out = RegionUnwrapper::new(frame.camera(), frame.kind(), &c)?.run(frame)?;
+            let s = score(&out, &measured(frame), truth, TOLERANCE_M)?;
+            yield_sum += s.yield_percent;
+            worst = worst.max(s.wrong_kept_percent);
+        }
+        let cand = TunedRegions {
+            config,
+            train_yield_percent: yield_sum / frames.len().max(1) as Real,
+            train_max_wrong_percent: worst,
+            within_limit: worst <= WRONG_LIMIT_PERCENT,
+        };
+        let better = match &best {
+            None => true,
+            Some(b) => match (cand.within_limit, b.within_limit) {
+                (true, false) => true,
+                (false, true) => false,
+                (true, true) => cand.train_yield_percent > b.train_yield_percent,
+                (false, false) => {
+                    (cand.train_max_wrong_percent, -cand.train_yield_percent)
+                        < (b.train_max_wrong_percent, -b.train_yield_percent)
+                }
+            },
+        };
+        if better {
+            best = Some(cand);
+        }
+    }
+    best.ok_or_else(|| TofError::BadParameter { what: "region grid", why: "empty".into() })
+}
+
+/// A simulated scene's frame (noise from `seed`), its truth and the AAT matching the
+/// simulator ([`aat_for`]): a training frame for [`tune_regions`].
+pub fn training_frame(scene: &TofScene, seed: u64) -> Result<TrainingFrame, TofError> {
+    let simulator = TofSimulator::new(scene.sim.clone())?;
+    let shot = simulator.simulate(&scene.scene, &scene.pose, seed)?;
+    Ok((shot.frame, shot.truth, aat_for(&simulator)))
+}
+
+/// Region unwrapping tuned on the six simulated scenes of Table 2.4 with the noise of
+/// `tune_seed` ([`tune_regions`] over [`RegionGrid::simulated`] on [`RegionConfig::new`]; each
+/// scene's AAT from its simulator): the parameters to score on another seed.
+pub fn tune_on_scenes(tune_seed: u64) -> Result<TunedRegions, TofError> {
+    let frames = crate::scenes::all_scenes()?
+        .iter()
+        .map(|s| training_frame(s, tune_seed))
+        .collect::<Result<Vec<_>, _>>()?;
+    tune_regions(&frames, &RegionConfig::new(AatConfig::sr3000()), &RegionGrid::simulated())
+}
+
+/// [`SceneResult::recoverable_percent`] and [`SceneResult::recoverable_any_percent`].
+fn ceilings(frame: &TofFrame, truth: &FrameTruth) -> (Real, Real) {
+    let radial = frame.converted(RangeKind::Radial);
+    let amb = frame.camera().non_ambiguity_range();
+    let r = |k| recoverable_percent(radial.range(), truth, amb, k, TOLERANCE_M);
+    (r(1), r(u8::MAX))
 }
 
 /// Runs one method on a frame (and the second-frequency frame for [`Method::TwoFreq`]) and
@@ -265,7 +458,18 @@ pub fn run_method(
         )),
         _ => None,
     };
+    let regions = match method {
+        Method::Regions(r) => Some(RegionUnwrapper::new(
+            camera,
+            kind,
+            &RegionConfig { aat: aat.clone(), ..(**r).clone() },
+        )?),
+        _ => None,
+    };
     let t0 = Instant::now();
+    if let Some(r) = &regions {
+        r.apply(frame, &mut out)?;
+    }
     if let Some(f) = &filter {
         f.apply(frame, &mut out)?;
         if let Some(sc) = &spatial {
@@ -331,6 +535,13 @@ pub struct FoldedResult {
     pub wrapped_percent: Real,
     /// Thresholds tuned on the even rows: (method, threshold).
     pub thresholds: Vec<(String, Real)>,
+    /// The region-unwrapping parameters tuned on the even rows ([`RegionGrid::folded`]).
+    pub regions: TunedRegions,
+    /// % of the measured pixels of the odd rows some wrap count 0 or 1 puts within
+    /// [`TOLERANCE_M`] of the truth (the ceiling of unwrapping at most once).
+    pub recoverable_percent: Real,
+    /// The same with any wrap count.
+    pub recoverable_any_percent: Real,
     /// Every method scored on the odd rows.
     pub results: Vec<MethodResult>,
 }
@@ -483,6 +694,11 @@ pub fn evaluate_folded(
         max_range,
         phase_noise,
     )?;
+    let tuned = tune_regions(
+        &[(train.clone(), train_truth.clone(), aat.clone())],
+        &RegionConfig::new(aat.clone()),
+        &RegionGrid::folded(),
+    )?;
     let methods = [
         Method::At(at),
         Method::Aat,
@@ -490,7 +706,9 @@ pub fn evaluate_folded(
         Method::AatUnwrapSpatial { low_at: None, isolation_support: 0 },
         Method::AatUnwrapSpatial { low_at: None, isolation_support: 3 },
         Method::TwoFreq,
+        Method::Regions(Box::new(tuned.config.clone())),
     ];
+    let (recoverable_percent, recoverable_any_percent) = ceilings(&test, &test_truth);
     let results = methods
         .iter()
         .map(|m| run_method(m, &test, Some(&test2), &aat, &two, &test_truth))
@@ -503,6 +721,9 @@ pub fn evaluate_folded(
         measured,
         wrapped_percent: 100.0 * wrapped_n as Real / measured.max(1) as Real,
         thresholds: vec![("AT".into(), at), ("AAT (a·r²)".into(), t_aat)],
+        regions: tuned,
+        recoverable_percent,
+        recoverable_any_percent,
         results,
     })
 }
@@ -578,6 +799,55 @@ pub fn table_2_4(results: &[SceneResult]) -> String {
         s.push('\n');
     }
     s
+}
+
+/// The view: per scene (or fold) and method the discarded %, the wrong % of output and
+/// the yield (correct output pixels, % of the measured pixels), beside the scene's ceiling
+/// (% of measured pixels any unwrapping by at most one non-ambiguity range could output
+/// correctly; in brackets, with any number). Methods meeting both goals (wrong ≤ 1 %,
+/// yield ≥ 80 %) are marked `*`.
+pub fn yield_table(results: &[SceneResult]) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<18} {:>15} {:<28} {:>8} {:>8} {:>8}",
+        "scene", "ceiling% (any)", "method", "disc.%", "wrong%", "yield%"
+    );
+    for r in results {
+        for m in &r.results {
+            let q = &m.score;
+            let ok = q.wrong_kept_percent <= WRONG_LIMIT_PERCENT && q.yield_percent >= 80.0;
+            let _ = writeln!(
+                s,
+                "{:<18} {:>6.1} ({:>6.1}) {:<28} {:>8.1} {:>8.2} {:>7.1}{}",
+                r.scene,
+                r.recoverable_percent,
+                r.recoverable_any_percent,
+                m.method,
+                q.discarded_percent,
+                q.wrong_kept_percent,
+                q.yield_percent,
+                if ok { "*" } else { "" }
+            );
+        }
+    }
+    s
+}
+
+impl FoldedResult {
+    /// As a [`SceneResult`] named `real-folded-<fold>m`, for [`yield_table`] and
+    /// [`quality_table`].
+    pub fn as_scene(&self) -> SceneResult {
+        SceneResult {
+            scene: format!("real-folded-{}m", self.fold_m),
+            wrapped_percent: self.wrapped_percent,
+            thesis: ThesisDiscarded { aat: Real::NAN, at160: Real::NAN, at240: None },
+            recoverable_percent: self.recoverable_percent,
+            recoverable_any_percent: self.recoverable_any_percent,
+            results: self.results.clone(),
+        }
+    }
 }
 
 /// What the thesis could not measure: per scene and method the % wrong pixels among those

@@ -29,6 +29,7 @@ pub mod experiment;
 pub mod filter;
 pub mod frame;
 pub mod io;
+pub mod regions;
 pub mod scenes;
 pub mod sim;
 pub mod spatial;
@@ -46,6 +47,7 @@ pub use filter::{
 };
 pub use frame::TofFrame;
 pub use io::FrameMeta;
+pub use regions::{RegionConfig, RegionUnwrapper};
 pub use sim::{SimConfig, SimulatedFrame, TofSimulator};
 pub use spatial::SpatialConfig;
 pub use two_freq::{TwoFreqConfig, TwoFreqUnwrapper};

@@ -1,4 +1,5 @@
-//! The time-of-flight frame (thesis §2.5: the AAT with unwrapping on a Table 2.4 scene) and
+//! The time-of-flight frame (thesis §2.5: a Table 2.4 scene, filtered by region unwrapping,
+//! the safe mode beyond the thesis) and
 //! the terrain snapshot (Ch. 4: the plane Hough transform and Algorithm 3).
 
 use super::Files;
@@ -11,9 +12,10 @@ use hough_terrain::{
 use pointcloud::{Point3, SensorPose};
 use scene_sim::{HoughClass, RangeCamera, RangeSensor, TerrainSpec, terrain as terrain_scene};
 use sensor_tof::experiment::{TOLERANCE_M, aat_for};
+use sensor_tof::regions::{RegionConfig, RegionUnwrapper};
 use sensor_tof::scenes::tof_scene;
 use sensor_tof::sim::TofSimulator;
-use sensor_tof::{FilterConfig, PixelOutcome, TofFilter, score};
+use sensor_tof::{PixelOutcome, score};
 use std::time::Instant;
 
 /// The Table 2.4 scene the demo filters: a rack before an open door, the room behind beyond
@@ -36,18 +38,19 @@ fn terrain_spec() -> TerrainSpec {
     TerrainSpec::Ramp { pitch: 30f64.to_radians(), roll: 0.0, distance: 1.5 }
 }
 
-/// Simulates the ToF frame, filters it with the AAT and unwrapping (no low AT), scores it
-/// against the simulator's truth and writes the output cloud (`tof-cloud.ply`, with the
-/// `outcome` field) in the camera's optical frame.
+/// Simulates the ToF frame, filters it with region unwrapping (the safe mode beyond the
+/// thesis, [`RegionConfig::simulated_sr3000`]: it unwraps only where a region's ranges and
+/// amplitudes agree), scores it against the simulator's truth (wrong % and yield) and writes
+/// the output cloud (`tof-cloud.ply`, with the `outcome` field) in the camera's optical frame.
 pub fn tof(seed: u64, files: &mut Files) -> Result<TofSection> {
     let scene = tof_scene(TOF_SCENE)?;
     let simulator = TofSimulator::new(scene.sim.clone())?;
     let sim = simulator.simulate(&scene.scene, &scene.pose, seed)?;
     let frame = &sim.frame;
-    let config = FilterConfig::aat_unwrap(aat_for(&simulator), None);
-    let filter = TofFilter::new(frame.camera(), frame.kind(), &config)?;
+    let config = RegionConfig::simulated_sr3000(aat_for(&simulator));
+    let unwrapper = RegionUnwrapper::new(frame.camera(), frame.kind(), &config)?;
     let t0 = Instant::now();
-    let out = filter.run(frame)?;
+    let out = unwrapper.run(frame)?;
     let millis = t0.elapsed().as_secs_f64() * 1e3;
     let measured: Vec<bool> = frame.range().iter().map(|&r| r > 0.0).collect();
     let s = score(&out, &measured, &sim.truth, TOLERANCE_M)?;
@@ -70,11 +73,12 @@ pub fn tof(seed: u64, files: &mut Files) -> Result<TofSection> {
         height: camera.height,
         outcomes,
         radial: out.radial.clone(),
-        method: "AAT+unwrap".to_owned(),
+        method: "regions".to_owned(),
         discarded_percent: s.discarded_percent,
         wrapped_percent: 100.0 * wrapped as f64 / sim.truth.wraps.len().max(1) as f64,
         unwrapped_correct_percent: s.unwrapped_correct_percent,
         wrong_percent: s.wrong_kept_percent,
+        yield_percent: s.yield_percent,
         millis,
     })
 }

@@ -170,6 +170,7 @@ mod tests {
             wrapped_percent: 0.0,
             unwrapped_correct_percent: 0.0,
             wrong_percent: 0.0,
+            yield_percent: 0.0,
             millis: 0.0,
         }
     }

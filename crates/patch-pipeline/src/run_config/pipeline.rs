@@ -532,6 +532,7 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
         wrapped_percent: f64::NAN,
         unwrapped_correct_percent: f64::NAN,
         wrong_percent: f64::NAN,
+        yield_percent: f64::NAN,
         millis,
     })
 }

@@ -91,6 +91,10 @@ fn quick_demo_fills_every_section() {
     assert!(outcomes.contains(&1), "no pixel unwrapped");
     assert!(tof["wrapped_percent"].as_f64().unwrap() > 0.0);
     assert!(tof["unwrapped_correct_percent"].as_f64().unwrap() > 0.0);
+    // The safe mode: at most 1 % of the output wrong, and the yield stated.
+    assert_eq!(tof["method"], "regions");
+    assert!(tof["wrong_percent"].as_f64().unwrap() <= 1.0, "{tof:?}");
+    assert!(tof["yield_percent"].as_f64().unwrap() > 0.0);
 
     // Terrain: the class found is the truth; a Hough picture (PNG signature) and three sectors.
     let t = &r["terrain"];

@@ -164,7 +164,7 @@ fn filter_writes_a_cloud_whose_outcomes_match_the_summary() {
         s(&r),
         s(&a),
         s(&m),
-        &["--unwrap", "--clamp-corners", "--safe", "--out", s(&out)],
+        &["--method", "aat", "--unwrap", "--clamp-corners", "--safe", "--out", s(&out)],
     );
     assert!(o.status.success(), "{}", stderr(&o));
     let [_, _, k2, u2, _, w2] = summary(&stdout(&o));
@@ -192,7 +192,7 @@ fn plain_at_and_cloud_input_agree_with_the_library() {
     let cloud = dir.path().join("frame.pcd");
     write_cloud(&cloud, &read.to_cloud()).unwrap();
     let run = |input: &[&str]| {
-        let mut args = vec!["tof", "filter", "--meta", s(&m), "--unwrap"];
+        let mut args = vec!["tof", "filter", "--meta", s(&m), "--method", "aat", "--unwrap"];
         args.extend_from_slice(input);
         args.extend_from_slice(&["--out", s(&out)]);
         let o = patchnav(&args);
@@ -354,7 +354,12 @@ fn calibrate_recovers_a_known_parabola() {
     // The calibration drives the filter.
     let (sr, sa, _) = write_pair(dir.path(), "scene", &scene(20e6, RangeKind::Depth));
     let out = dir.path().join("out.ply");
-    let o = filter_cmd(s(&sr), s(&sa), s(&m), &["--calibration", s(&calib), "--out", s(&out)]);
+    let o = filter_cmd(
+        s(&sr),
+        s(&sa),
+        s(&m),
+        &["--method", "aat", "--calibration", s(&calib), "--out", s(&out)],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).starts_with("AAT 0.2:"), "{}", stdout(&o));
 }
@@ -444,6 +449,40 @@ fn simulate_then_filter() {
     assert_one_line_error(&o, "unknown scene");
 }
 
+/// The default `--method regions` unwraps the far wall of the two-wall scene (a whole region
+/// too dark for its measured range) and keeps the near one, as the library does.
+#[test]
+fn regions_unwrap_the_far_wall_and_keep_the_near_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = scene(20e6, RangeKind::Depth);
+    let (r, a, m) = write_pair(dir.path(), "two", &frame);
+    let out = dir.path().join("regions.ply");
+    let o = filter_cmd(s(&r), s(&a), s(&m), &["--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let [total, measured, kept, unwrapped, dropped, written] = summary(&stdout(&o));
+    assert_eq!((total, kept + unwrapped + dropped), (176 * 144, total));
+    assert_eq!(written, kept + unwrapped);
+    // Left of column 88 the near wall (3 m), right of it the far one (9 m, read as 1.5 m).
+    assert!(kept > measured / 3 && unwrapped > measured / 3, "{kept} kept, {unwrapped} unwrapped");
+    let read = read_pair_of(&r, &a, &m);
+    let lib = sensor_tof::RegionUnwrapper::new(
+        read.camera(),
+        read.kind(),
+        &sensor_tof::RegionConfig::new(AatConfig::sr3000()),
+    )
+    .unwrap()
+    .run(&read)
+    .unwrap();
+    assert_eq!((lib.counts.kept, lib.counts.unwrapped), (kept, unwrapped));
+    let o = filter_cmd(s(&r), s(&a), s(&m), &["--unwrap", "--out", s(&out)]);
+    assert_one_line_error(&o, "--unwrap is for --method aat");
+}
+
+fn read_pair_of(r: &Path, a: &Path, m: &Path) -> TofFrame {
+    let meta = sensor_tof::io::read_meta(m).unwrap();
+    read_png_pair(r, a, &meta).unwrap()
+}
+
 /// `experiment tof` prints Table 2.4 beside the thesis's.
 #[test]
 fn experiment_tof_prints_table_2_4() {
@@ -455,4 +494,6 @@ fn experiment_tof_prints_table_2_4() {
         assert!(out.contains(scene), "{scene} missing: {out}");
     }
     assert!(out.contains("median"));
+    // The yield table with the new mode, tuned on another seed.
+    assert!(out.contains("regions (tuned)") && out.contains("yield%"), "{out}");
 }
