@@ -255,6 +255,12 @@ pub struct RegionGrid {
     pub max_noise_m: Vec<Option<Real>>,
     /// [`RegionConfig::join_curvature_m`].
     pub join_curvature_m: Vec<Option<Real>>,
+    /// [`RegionConfig::min_brightness`].
+    pub min_brightness: Vec<Real>,
+    /// [`RegionConfig::absorb_passes`].
+    pub absorb_passes: Vec<u32>,
+    /// [`RegionConfig::min_region_pixels`].
+    pub min_region_pixels: Vec<usize>,
 }
 
 impl RegionGrid {
@@ -268,6 +274,9 @@ impl RegionGrid {
             low_at: vec![None, Some(100.0), Some(200.0)],
             max_noise_m: vec![None, Some(0.02)],
             join_curvature_m: vec![None, Some(0.02)],
+            min_brightness: vec![1.0],
+            absorb_passes: vec![0, 3],
+            min_region_pixels: vec![20],
         }
     }
 
@@ -275,39 +284,49 @@ impl RegionGrid {
     /// non-ambiguity ranges, millimetre noise: no amplitude floor or noise gate).
     pub fn folded() -> RegionGrid {
         RegionGrid {
-            max_brightness: vec![4.0, 6.0, 10.0, 16.0],
+            max_brightness: vec![6.0, 10.0, 16.0],
             max_amplitude_ratio: vec![1.5, 3.0],
             min_margin: vec![0.2, 0.5],
             max_wraps: vec![1, 3],
             low_at: vec![None],
             max_noise_m: vec![None],
             join_curvature_m: vec![Some(0.005), Some(0.02)],
+            min_brightness: vec![1.0, 0.5],
+            absorb_passes: vec![0, 3],
+            min_region_pixels: vec![20, 60, 150],
         }
     }
 
     /// Every combination, each on a copy of `base`.
     pub fn configs(&self, base: &RegionConfig) -> Vec<RegionConfig> {
         let mut v = Vec::new();
-        for &b in &self.max_brightness {
-            for &r in &self.max_amplitude_ratio {
-                for &m in &self.min_margin {
-                    for &k in &self.max_wraps {
-                        for &l in &self.low_at {
-                            for (&n, &c) in self
-                                .max_noise_m
-                                .iter()
-                                .flat_map(|n| self.join_curvature_m.iter().map(move |c| (n, c)))
-                            {
-                                v.push(RegionConfig {
-                                    join_curvature_m: c,
-                                    max_brightness: b,
-                                    max_amplitude_ratio: r,
-                                    min_margin: m,
-                                    max_wraps: k,
-                                    low_at: l,
-                                    max_noise_m: n,
-                                    ..base.clone()
-                                });
+        for &size in &self.min_region_pixels {
+            for &b in &self.max_brightness {
+                for &r in &self.max_amplitude_ratio {
+                    for &m in &self.min_margin {
+                        for &k in &self.max_wraps {
+                            for &l in &self.low_at {
+                                for (&n, &c, &mb, &ab) in self.max_noise_m.iter().flat_map(|n| {
+                                    self.join_curvature_m.iter().flat_map(move |c| {
+                                        self.min_brightness.iter().flat_map(move |mb| {
+                                            self.absorb_passes.iter().map(move |ab| (n, c, mb, ab))
+                                        })
+                                    })
+                                }) {
+                                    v.push(RegionConfig {
+                                        join_curvature_m: c,
+                                        min_brightness: mb,
+                                        absorb_passes: ab,
+                                        min_region_pixels: size,
+                                        max_brightness: b,
+                                        max_amplitude_ratio: r,
+                                        min_margin: m,
+                                        max_wraps: k,
+                                        low_at: l,
+                                        max_noise_m: n,
+                                        ..base.clone()
+                                    });
+                                }
                             }
                         }
                     }

@@ -71,6 +71,10 @@ pub struct RegionConfig {
     pub max_amplitude_ratio: Real,
     /// Regions with fewer pixels are dropped (≥ 1, default 20).
     pub min_region_pixels: usize,
+    /// A pixel supports an offset only when its apparent reflectivity there is at least this
+    /// times `T` (> 0, default 1: the AAT's own criterion; below 1 a dark region is plausible
+    /// both as measured and unwrapped, and the fit or its border must decide).
+    pub min_brightness: Real,
     /// `B`: a pixel supports an offset when its apparent reflectivity there is at most `B · T`
     /// (> 1, default 10, i.e. twice a white wall with the thesis's `T` = 0.2: surfaces at
     /// grazing incidence and the illumination model's errors leave room above 1).
@@ -107,6 +111,13 @@ pub struct RegionConfig {
     pub max_noise_m: Option<Real>,
     /// The half-size of the noise window (1 to 7, default 2: 5 × 5).
     pub noise_radius: u32,
+    /// Passes that give a dropped measured pixel (of a small region, say) the wrap count of
+    /// its output 8-neighbours, when at least two agree within
+    /// [`RegionConfig::absorb_tolerance_m`] (plus the relative join tolerance) and none
+    /// disagrees (default 0: off). Each pass grows the output by one pixel.
+    pub absorb_passes: u32,
+    /// The absolute tolerance of that agreement, metres (default 0.02).
+    pub absorb_tolerance_m: Real,
 }
 
 impl RegionConfig {
@@ -119,6 +130,7 @@ impl RegionConfig {
             join_curvature_m: None,
             max_amplitude_ratio: 2.0,
             min_region_pixels: 20,
+            min_brightness: 1.0,
             max_brightness: 10.0,
             min_support: 0.5,
             min_margin: 0.2,
@@ -129,6 +141,8 @@ impl RegionConfig {
             low_at: None,
             max_noise_m: Some(0.02),
             noise_radius: 2,
+            absorb_passes: 0,
+            absorb_tolerance_m: 0.02,
         }
     }
 
@@ -199,6 +213,23 @@ impl RegionConfig {
         {
             return bad("maximum noise", format!("{t} m (want finite > 0)"));
         }
+        if !(self.min_brightness.is_finite() && self.min_brightness > 0.0)
+            || self.min_brightness >= self.max_brightness
+        {
+            return bad(
+                "minimum brightness",
+                format!("{} (want finite > 0 and below the maximum)", self.min_brightness),
+            );
+        }
+        if self.absorb_passes > 100 {
+            return bad("absorb passes", format!("{} (want 0 to 100)", self.absorb_passes));
+        }
+        if !(self.absorb_tolerance_m.is_finite() && self.absorb_tolerance_m >= 0.0) {
+            return bad(
+                "absorb tolerance",
+                format!("{} m (want finite ≥ 0)", self.absorb_tolerance_m),
+            );
+        }
         if !(1..=7).contains(&self.noise_radius) {
             return bad("noise radius", format!("{} (want 1 to 7)", self.noise_radius));
         }
@@ -221,6 +252,9 @@ pub struct RegionStats {
     pub too_many_wraps: usize,
     /// Pixels dropped as too noisy ([`RegionConfig::max_noise_m`]).
     pub noisy: usize,
+    /// Dropped pixels given their output neighbours' wrap count
+    /// ([`RegionConfig::absorb_passes`]).
+    pub absorbed: usize,
 }
 
 /// [`RegionConfig`] prepared for one camera and range kind (illumination and ray tables
@@ -252,6 +286,76 @@ fn mad(v: &mut [Real]) -> Real {
 /// How many offsets beyond [`RegionConfig::max_wraps`] a region is also tested at: a region
 /// that fits better there is dropped rather than unwrapped too little.
 const EXTRA_OFFSETS: usize = 3;
+
+/// Gives dropped measured pixels the wrap count their output neighbours agree on
+/// ([`RegionConfig::absorb_passes`]); returns how many were added.
+fn absorb(
+    out: &mut FilterOutput,
+    radial: &[Real],
+    valid: &[bool],
+    w: usize,
+    h: usize,
+    amb: Real,
+    cfg: &RegionConfig,
+) -> usize {
+    let mut added = 0;
+    for _ in 0..cfg.absorb_passes {
+        let before = out.outcomes.clone();
+        let ranges = out.radial.clone();
+        let mut changed = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                if !valid[i] || before[i].is_output() {
+                    continue;
+                }
+                let (mut k_agreed, mut votes, mut against) = (None, 0u32, false);
+                for dy in -1isize..=1 {
+                    for dx in -1isize..=1 {
+                        let (nx, ny) = (x as isize + dx, y as isize + dy);
+                        if (dx, dy) == (0, 0)
+                            || nx < 0
+                            || ny < 0
+                            || nx >= w as isize
+                            || ny >= h as isize
+                        {
+                            continue;
+                        }
+                        let j = ny as usize * w + nx as usize;
+                        if !before[j].is_output() {
+                            continue;
+                        }
+                        let u = ranges[j] as Real;
+                        let k = ((u - radial[i]) / amb).round();
+                        let tol = cfg.absorb_tolerance_m + cfg.join_relative * u;
+                        if (radial[i] + k * amb - u).abs() > tol || k < 0.0 {
+                            against = true;
+                        } else if k_agreed.is_none_or(|a| a == k) {
+                            k_agreed = Some(k);
+                            votes += 1;
+                        } else {
+                            against = true;
+                        }
+                    }
+                }
+                if let (Some(k), false) = (k_agreed, against)
+                    && votes >= 2
+                    && k <= cfg.max_wraps as Real
+                {
+                    out.outcomes[i] =
+                        if k == 0.0 { PixelOutcome::Kept } else { PixelOutcome::Unwrapped };
+                    out.radial[i] = (radial[i] + k * amb) as f32;
+                    changed += 1;
+                }
+            }
+        }
+        added += changed;
+        if changed == 0 {
+            break;
+        }
+    }
+    added
+}
 
 /// Drops the output pixels whose local noise estimate exceeds `max` ([`RegionConfig::max_noise_m`]);
 /// returns how many.
@@ -540,7 +644,8 @@ impl RegionUnwrapper {
                         AatRange::Depth => u / rpd[i] as Real,
                     };
                     let rho = a * q * q;
-                    *s += (rho >= lim && rho <= cfg.max_brightness * lim) as usize;
+                    *s += (rho >= cfg.min_brightness * lim && rho <= cfg.max_brightness * lim)
+                        as usize;
                 }
             }
             let share = |k: usize| support[k] as Real / voters.max(1) as Real;
@@ -640,6 +745,9 @@ impl RegionUnwrapper {
             }
             out.outcomes[i] = if k == 0 { PixelOutcome::Kept } else { PixelOutcome::Unwrapped };
             out.radial[i] = (radial[i] + k as Real * amb) as f32;
+        }
+        if cfg.absorb_passes > 0 {
+            stats.absorbed = absorb(out, &radial, &valid, w, h, amb, cfg);
         }
         if let Some(max) = cfg.max_noise_m {
             stats.noisy = drop_noisy(out, &label, w, h, cfg.noise_radius as usize, max);
@@ -790,9 +898,36 @@ mod tests {
     }
 
     #[test]
+    fn absorbing_fills_a_small_patch_its_neighbours_agree_on() {
+        let (c, config) = setup(15e6);
+        let z = pointcloud::Vector3::z();
+        // A 50 % wall at 3 m with a 4 × 4 patch five times brighter: too unlike its neighbours
+        // to join them, too small to stand alone.
+        let (frame, truth) = render(&c, |d| {
+            let t = plane(d, z, 3.0)?;
+            let (x, y) = (d.x / d.z, d.y / d.z);
+            let bright = x.abs() < 0.04 && y.abs() < 0.04;
+            Some((t, if bright { 2.5 } else { 0.5 }))
+        });
+        let u = RegionUnwrapper::new(&c, RangeKind::Radial, &config).unwrap();
+        let mut out = FilterOutput::default();
+        let stats = u.apply(&frame, &mut out).unwrap();
+        let patch = stats.small;
+        assert!(patch > 0 && out.counts.kept == frame.num_measured() - patch, "{stats:?}");
+        let cfg = RegionConfig { absorb_passes: 3, ..config };
+        let u = RegionUnwrapper::new(&c, RangeKind::Radial, &cfg).unwrap();
+        let stats = u.apply(&frame, &mut out).unwrap();
+        assert_eq!((stats.absorbed, out.counts.kept), (patch, frame.num_measured()), "{stats:?}");
+        assert_eq!(score(&out, &measured(&frame), &truth, 0.01).unwrap().wrong_kept_percent, 0.0);
+    }
+
+    #[test]
     fn absurd_parameters_are_refused() {
         let (c, base) = setup(15e6);
-        let bad: [fn(&mut RegionConfig); 11] = [
+        let bad: [fn(&mut RegionConfig); 14] = [
+            |c| c.min_brightness = 0.0,
+            |c| c.min_brightness = c.max_brightness,
+            |c| c.absorb_passes = 101,
             |c| c.join_absolute_m = -1.0,
             |c| c.join_relative = 0.5,
             |c| c.join_curvature_m = Some(Real::NAN),

@@ -125,12 +125,16 @@ pub fn run(args: &TofSetup, progress: &dyn Progress) -> Result<()> {
 /// The tuned fields of a region configuration, one line.
 pub fn describe(c: &RegionConfig) -> String {
     format!(
-        "brightness ≤ {} T, amplitude ratio ≤ {}, margin {}, wraps ≤ {}, low AT {}, noise ≤ {}",
+        "regions ≥ {} pixels, brightness {}–{} T, amplitude ratio ≤ {}, curvature {}, margin {}, wraps ≤ {}, low AT {}, noise ≤ {}, absorb passes {}",
+        c.min_region_pixels,
+        c.min_brightness,
         c.max_brightness,
         c.max_amplitude_ratio,
+        c.join_curvature_m.map_or("off".into(), |t| format!("{} cm", t * 100.0)),
         c.min_margin,
         c.max_wraps,
         c.low_at.map_or("off".into(), |t| format!("{t}")),
-        c.max_noise_m.map_or("off".into(), |t| format!("{} cm", t * 100.0))
+        c.max_noise_m.map_or("off".into(), |t| format!("{} cm", t * 100.0)),
+        c.absorb_passes
     )
 }
