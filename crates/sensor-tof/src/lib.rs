@@ -1,7 +1,7 @@
 //! Time-of-flight cameras (thesis §2.3 and §2.5, spec `tof-hough.md` §1, §2, §6): the camera
 //! model, frames, the simulator, wrap-around detection by the adaptive amplitude threshold,
 //! unwrapping, and what goes beyond the thesis (two-frequency unwrapping, a spatial consistency
-//! check).
+//! check, region unwrapping).
 //!
 //! | what | module | thesis |
 //! |---|---|---|
@@ -11,6 +11,7 @@
 //! | white-wall calibration (parabola fit or raw table) | [`calibrate`] | L2338–2348 |
 //! | two-frequency unwrapping | [`two_freq`] | beyond the thesis |
 //! | spatial consistency of the flags | [`spatial`] | beyond the thesis |
+//! | region unwrapping: unwrap only where a smooth region agrees | [`regions`] | beyond the thesis |
 //! | simulator on `scene-sim`'s range camera | [`sim`] | §2.5.4 error types, Table 2.3 |
 //! | the six test scenes of Table 2.4 | [`scenes`] | §2.5.6 |
 //! | scoring against the truth | [`eval`] | Table 2.4 (+ our metrics) |
@@ -47,7 +48,7 @@ pub use filter::{
 };
 pub use frame::TofFrame;
 pub use io::FrameMeta;
-pub use regions::{RegionConfig, RegionUnwrapper};
+pub use regions::{RegionConfig, RegionUnwrapper, ScatterGate};
 pub use sim::{SimConfig, SimulatedFrame, TofSimulator};
 pub use spatial::SpatialConfig;
 pub use two_freq::{TwoFreqConfig, TwoFreqUnwrapper};

@@ -118,6 +118,34 @@ pub struct RegionConfig {
     pub absorb_passes: u32,
     /// The absolute tolerance of that agreement, metres (default 0.02).
     pub absorb_tolerance_m: Real,
+    /// Drop pixels that light scattered inside the camera may have pulled too close (`None`:
+    /// off, the default).
+    pub scattering: Option<ScatterGate>,
+}
+
+/// Light scattered inside the camera (thesis L1997–2005, Fig 2.10) adds to every pixel a blur
+/// of the whole frame's returns, which pulls a dim pixel beside bright ones towards their
+/// range. The gate estimates it from the frame: `strength ×` three box blurs of half-width
+/// `radius` of the complex image `a · e^{iφ}` (the camera's scattering, from a calibration),
+/// and drops a pixel whose estimated scattered amplitude exceeds `max_share` of its own
+/// (beyond the thesis).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScatterGate {
+    /// The fraction of the blurred light that reaches a pixel, in (0, 1].
+    pub strength: Real,
+    /// Half-width of each box pass, pixels (1 to 1000).
+    pub radius: u32,
+    /// The largest tolerated share of scattered to measured amplitude (> 0): with `s/a` the
+    /// phase errs by up to about `s/a` radians, i.e. `R · s/a / 2π` metres.
+    pub max_share: Real,
+}
+
+impl ScatterGate {
+    /// The simulator's SR-3000 scattering ([`crate::sim::Scattering::sr3000`]: 1 %, radius
+    /// 30) with a share of 0.02 (at most 2.4 cm of error at R = 7.5 m).
+    pub fn sr3000() -> ScatterGate {
+        ScatterGate { strength: 0.01, radius: 30, max_share: 0.02 }
+    }
 }
 
 impl RegionConfig {
@@ -143,14 +171,22 @@ impl RegionConfig {
             noise_radius: 2,
             absorb_passes: 0,
             absorb_tolerance_m: 0.02,
+            scattering: None,
         }
     }
 
     /// The parameters tuned on the six simulated Table 2.4 scenes of seed 1 (`patchnav
     /// experiment tof` prints the tuning; SR-3000/3100 amplitudes): [`RegionConfig::new`] with
-    /// a low AT of 100. The demo's mode.
+    /// brightness ≤ 6 T, a low AT of 200, three absorbing passes and the scattering gate of the
+    /// simulated camera ([`ScatterGate::sr3000`]). The demo's mode.
     pub fn simulated_sr3000(aat: AatConfig) -> RegionConfig {
-        RegionConfig { low_at: Some(100.0), ..RegionConfig::new(aat) }
+        RegionConfig {
+            max_brightness: 6.0,
+            low_at: Some(200.0),
+            absorb_passes: 3,
+            scattering: Some(ScatterGate::sr3000()),
+            ..RegionConfig::new(aat)
+        }
     }
 
     /// Checks every field (the AAT's own fields are checked by [`RegionUnwrapper::new`]).
@@ -230,6 +266,19 @@ impl RegionConfig {
                 format!("{} m (want finite ≥ 0)", self.absorb_tolerance_m),
             );
         }
+        if let Some(g) = self.scattering
+            && !(g.strength.is_finite()
+                && g.strength > 0.0
+                && g.strength <= 1.0
+                && (1..=1000).contains(&g.radius)
+                && g.max_share.is_finite()
+                && g.max_share > 0.0)
+        {
+            return bad(
+                "scattering gate",
+                format!("{g:?} (want strength in (0, 1], radius 1 to 1000, share > 0)"),
+            );
+        }
         if !(1..=7).contains(&self.noise_radius) {
             return bad("noise radius", format!("{} (want 1 to 7)", self.noise_radius));
         }
@@ -252,6 +301,8 @@ pub struct RegionStats {
     pub too_many_wraps: usize,
     /// Pixels dropped as too noisy ([`RegionConfig::max_noise_m`]).
     pub noisy: usize,
+    /// Pixels dropped by the scattering gate ([`RegionConfig::scattering`]).
+    pub scattered: usize,
     /// Dropped pixels given their output neighbours' wrap count
     /// ([`RegionConfig::absorb_passes`]).
     pub absorbed: usize,
@@ -526,12 +577,33 @@ impl RegionUnwrapper {
         let valid: Vec<bool> = (0..n)
             .map(|i| frame.range()[i] > 0.0 && (amp[i] as Real) > low && amp[i] > 0.0)
             .collect();
+        let mut valid = valid;
+        let mut scattered_out = 0;
+        if let Some(g) = cfg.scattering {
+            let (mut re, mut im) = (vec![0.0; n], vec![0.0; n]);
+            for i in 0..n {
+                if frame.range()[i] > 0.0 {
+                    let phi = std::f64::consts::TAU * radial[i] / amb;
+                    re[i] = amp[i] as Real * phi.cos();
+                    im[i] = amp[i] as Real * phi.sin();
+                }
+            }
+            let r = g.radius as usize;
+            let (re, im) = (crate::sim::blur(&re, w, h, r), crate::sim::blur(&im, w, h, r));
+            for i in 0..n {
+                let scattered = g.strength * re[i].hypot(im[i]);
+                if scattered > g.max_share * amp[i] as Real {
+                    scattered_out += valid[i] as usize;
+                    valid[i] = false;
+                }
+            }
+        }
         let mut label = vec![NONE; n];
         let mut wrap = vec![0i32; n];
         let mut queue: Vec<usize> = Vec::new();
         let mut members: Vec<usize> = Vec::new();
         let mut logs: Vec<Real> = Vec::new();
-        let mut stats = RegionStats::default();
+        let mut stats = RegionStats { scattered: scattered_out, ..RegionStats::default() };
         let ratio = cfg.max_amplitude_ratio as f32;
         // The relative wrap step from i to j if they join, else None.
         // The step from a to b modulo the non-ambiguity range.
@@ -924,7 +996,8 @@ mod tests {
     #[test]
     fn absurd_parameters_are_refused() {
         let (c, base) = setup(15e6);
-        let bad: [fn(&mut RegionConfig); 14] = [
+        let bad: [fn(&mut RegionConfig); 15] = [
+            |c| c.scattering = Some(ScatterGate { radius: 0, ..ScatterGate::sr3000() }),
             |c| c.min_brightness = 0.0,
             |c| c.min_brightness = c.max_brightness,
             |c| c.absorb_passes = 101,

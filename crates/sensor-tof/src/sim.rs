@@ -519,7 +519,7 @@ pub fn oren_nayar_retro(sigma: Real) -> Real {
 
 /// Three passes of a normalised separable box blur of half-width `radius` (each output is the
 /// mean over the in-image part of its window): ≈ a Gaussian of σ ≈ radius, O(n) per pass.
-fn blur(img: &[Real], w: usize, h: usize, radius: usize) -> Vec<Real> {
+pub(crate) fn blur(img: &[Real], w: usize, h: usize, radius: usize) -> Vec<Real> {
     let mut a = img.to_vec();
     let mut line = Vec::with_capacity(w.max(h));
     for _ in 0..3 {

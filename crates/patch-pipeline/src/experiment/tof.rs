@@ -125,7 +125,7 @@ pub fn run(args: &TofSetup, progress: &dyn Progress) -> Result<()> {
 /// The tuned fields of a region configuration, one line.
 pub fn describe(c: &RegionConfig) -> String {
     format!(
-        "regions ≥ {} pixels, brightness {}–{} T, amplitude ratio ≤ {}, curvature {}, margin {}, wraps ≤ {}, low AT {}, noise ≤ {}, absorb passes {}",
+        "regions ≥ {} pixels, brightness {}–{} T, amplitude ratio ≤ {}, curvature {}, margin {}, wraps ≤ {}, low AT {}, noise ≤ {}, absorb passes {}, scattering gate {}",
         c.min_region_pixels,
         c.min_brightness,
         c.max_brightness,
@@ -135,6 +135,12 @@ pub fn describe(c: &RegionConfig) -> String {
         c.max_wraps,
         c.low_at.map_or("off".into(), |t| format!("{t}")),
         c.max_noise_m.map_or("off".into(), |t| format!("{} cm", t * 100.0)),
-        c.absorb_passes
+        c.absorb_passes,
+        c.scattering.map_or("off".into(), |g| format!(
+            "{} % over {} px, share ≤ {}",
+            g.strength * 100.0,
+            g.radius,
+            g.max_share
+        ))
     )
 }
