@@ -46,4 +46,12 @@ fn table_2_4_facts_hold_on_the_simulated_scenes() {
         get("sun", "AAT+AT20+unwrap").wrong_kept_percent
             < get("sun", "AAT+unwrap").wrong_kept_percent / 2.0
     );
+    // Region unwrapping (its preset was tuned on seed 1; this is seed 7) keeps the wrong output
+    // under 1 % in every scene, where the AAT does not, and never yields more than the ceiling.
+    for r in &results {
+        let g = r.get("regions").unwrap().score;
+        assert!(g.wrong_kept_percent <= 1.0, "{}: {g:?}", r.scene);
+        assert!(g.yield_percent <= r.recoverable_any_percent + 1e-9, "{}: {g:?}", r.scene);
+        assert!(r.get("AAT").unwrap().score.wrong_kept_percent > 1.0, "{}", r.scene);
+    }
 }
