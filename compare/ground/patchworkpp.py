@@ -11,6 +11,7 @@ wall clock around `estimateGround`, which runs on one core).
 """
 
 import argparse
+import importlib.metadata
 import json
 import statistics
 import sys
@@ -47,7 +48,7 @@ def main() -> int:
     rest = times[1:]
     print(json.dumps({
         "tool": "patchworkpp",
-        "version": getattr(pypatchworkpp, "__version__", "unknown"),
+        "package": importlib.metadata.version("pypatchworkpp"),
         "points": int(len(cloud)),
         "ground": int(labels.sum()),
         "sensor_height_m": a.sensor_height,

@@ -15,6 +15,10 @@
 //! * `cargo xtask peers terrain [--peers-dir DIR] [--peers-build DIR] [--out F]`: our Hough
 //!   terrain classification beside one RANSAC ground-plane fit of PCL and Open3D on the same
 //!   frames, ratio ours/theirs (docs/terrain.md).
+//! * `cargo xtask peers ground [--scan-dir DIR] [--seeds 2,3] [--venv DIR] [--out F]`: our
+//!   per-point ground segmentation beside Patchwork++ (PyPI `pypatchworkpp` in a virtual
+//!   environment it creates) on the labelled SemanticKITTI scan, precision / recall / F1 and ms;
+//!   ours on simulated frames (docs/terrain.md).
 //! * `cargo xtask compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]`:
 //!   OMPL + FCL planners, OctoMap and PCL segmentation built from `compare/` beside ours on the
 //!   same inputs in one run, ratios ours/theirs; JSONL rows to `target/compare/`
@@ -51,6 +55,8 @@ commands:
                                         our plane extraction beside PCL and Open3D (same inputs)
   peers terrain [--peers-dir D] [--peers-build D] [--out F]
                                         Hough terrain classes beside a RANSAC ground plane (PCL, Open3D)
+  peers ground [--scan-dir D] [--seeds 2,3] [--venv D] [--out F]
+                                        per-point ground beside Patchwork++ (pip, in a venv)
   compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]
           [--lab-frames N] [--real-dir D]
                                         OMPL+FCL, OctoMap, PCL (built from compare/) beside ours

@@ -23,6 +23,7 @@
 use anyhow::{Context, Result, bail};
 use pointcloud::{Point3, Vector3};
 
+pub mod ground;
 pub mod terrain;
 use serde_json::{Value, json};
 use std::fmt::Write as _;

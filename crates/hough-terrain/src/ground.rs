@@ -14,24 +14,39 @@
 //!    stand-in for `atan2` that needs no trigonometry), so sectors are equal in it, not in
 //!    degrees. Organised and unorganised clouds, 360° lidar scans and camera frames all fall
 //!    into the same grid.
-//! 3. **Local plane per cell**: the mean height of the [`GroundSettings::seed_points`] lowest
-//!    points, the points within [`GroundSettings::seed_band`] above it as seeds, a
-//!    least-squares plane (PCA, the covariance's smallest eigenvector), refitted
-//!    [`GroundSettings::fit_iterations`] times to the points within
-//!    [`GroundSettings::fit_band`] of it.
-//! 4. **Accept** the plane as ground if its normal is within the robot's slope limit of
-//!    vertical and it continues the ground already accepted: ring by ring outwards, its height
-//!    at the cell's centre differs from the plane of the nearest accepted cell inwards (the same
-//!    azimuth or its neighbours, up to [`GroundSettings::max_gap_rings`] rings back) by at most
-//!    the robot's step limit plus [`GroundSettings::grade`] per metre between the two cells.
-//!    With no accepted cell inwards, the reference is the nominal ground and the limit is the
-//!    step limit alone. So a step up of more than 0.2 m and what lies beyond it is not ground,
-//!    nor is a ramp steeper than 35°, a table top, a car roof or a ceiling.
-//! 5. **Label**: a point is ground if it lies within the band of its cell's accepted plane
-//!    ([`GroundSettings::band_sigmas`] times the plane's residual, clamped to
-//!    [`GroundSettings::min_band`]..[`GroundSettings::max_band`]). In a cell with too few points
-//!    or a rejected plane (a wall with a little ground at its foot), the points within the band
-//!    of the inward reference plane are ground.
+//! 3. **Local plane per cell** (with at least [`GroundSettings::min_points`] points): the mean
+//!    height of the lowest points ([`GroundSettings::seed_points`], at most a quarter of the
+//!    cell), the points within the seed band above it ([`GroundSettings::seed_band`], at most
+//!    [`GroundSettings::seed_band_per_width`] of the ring's width) as seeds, a least-squares
+//!    plane through them (PCA: the covariance's smallest eigenvector, nalgebra's
+//!    `SymmetricEigen`), refitted [`GroundSettings::fit_iterations`] times to the points within
+//!    its band. The **band** is [`GroundSettings::band_sigmas`] times the rms distance of the
+//!    points *below* the plane (what stands on the ground lies above it and must not widen the
+//!    band), at least [`GroundSettings::min_band`] and [`GroundSettings::band_per_width`] of the
+//!    ring's width, at most [`GroundSettings::max_band`].
+//! 4. **Candidates**: a plane whose normal is within the robot's slope limit of vertical, whose
+//!    points spread across the cell ([`GroundSettings::min_spread`], not one scan line) and which
+//!    is not rough and raised at once (seed rms above [`GroundSettings::max_roughness`] and
+//!    more than [`GroundSettings::rough_height`] above the nominal ground: bushes, the top of a
+//!    hedge).
+//! 5. **Accept by growing** from the candidates that pass within [`GroundSettings::seed_step`]
+//!    of the nominal ground: a candidate next to accepted ground (the neighbouring sectors, the
+//!    overlapping cells of the neighbouring rings, or across up to
+//!    [`GroundSettings::max_gap_rings`] rings without any candidate) is ground if the two planes,
+//!    each evaluated where its own cell ends towards the other, differ by at most the robot's
+//!    step limit plus [`GroundSettings::grade`] per metre between those ends. So ground is what
+//!    the robot could reach over passable steps and slopes: a step of more than 0.2 m and what
+//!    lies beyond it is not ground, nor is a ramp steeper than 35°, a table top, a car roof or a
+//!    ceiling, while a curb and the sidewalk behind it are.
+//! 6. **Label**: a point is ground if it lies within the band of its cell's accepted plane or
+//!    of the nearest accepted plane inwards (so both sides of a passable step inside one cell
+//!    are ground; a cell with too few points or a rejected plane, such as a wall with a little
+//!    ground at its foot, is labelled by that plane alone, or by the nominal ground with
+//!    [`GroundSettings::max_band`] when there is none).
+//!
+//! The defaults were chosen on simulated frames (range camera and laser scanner, scene seed 1)
+//! and on the one labelled SemanticKITTI scan (the roughness rule, the band per width); see
+//! docs/terrain.md for the figures on other seeds.
 //!
 //! # Performance
 //!
@@ -64,26 +79,43 @@ pub struct GroundSettings {
     /// The mean of the lowest this many points of a cell (at most a quarter of them) is its
     /// seed height (default 20).
     pub seed_points: usize,
-    /// Seeds are the points up to this far above the seed height, metres (default 0.15).
+    /// Seeds are the points up to this far above the seed height, metres (default 0.15)...
     pub seed_band: f64,
+    /// ...but at most this share of the ring's width (default 0.4): in small cells near a
+    /// small robot's camera a wide seed band reaches up walls and box sides.
+    pub seed_band_per_width: f64,
     /// A plane's points must spread across the cell, not along one line (a single scan line
     /// far out): the standard deviation across their main direction at least this share of the
     /// ring's width (default 0.05). Otherwise the cell is labelled by the plane inwards.
     pub min_spread: f64,
-    /// Refits of the plane to the points within [`Self::fit_band`] (default 3).
+    /// A cell whose seeds lie farther than this from their plane (rms, metres) is rough, not
+    /// ground: bushes, rubble, the top of a crowd (default 0.03)...
+    pub max_roughness: f64,
+    /// ...if it lies more than this above the nominal ground, metres (default 0.2).
+    pub rough_height: f64,
+    /// Refits of the plane to the points within its band (default 1).
     pub fit_iterations: usize,
-    /// A refit takes the points within this distance of the plane, metres (default 0.125).
+    /// The band's residual counts the points up to this far below the plane, metres (default
+    /// 0.125).
     pub fit_band: f64,
-    /// The label band is this many times the plane's rms residual (default 3)...
+    /// The band is this many times the rms distance of the points below the plane (default
+    /// 3)...
     pub band_sigmas: f64,
-    /// ...at least this, metres (default 0.08)...
+    /// ...at least this, metres (default 0.02)...
     pub min_band: f64,
     /// ...and at most this, metres (default 0.15).
     pub max_band: f64,
-    /// The allowed height difference to the reference plane grows by this per metre between
-    /// the two cells (default 0.02), so that gently curved ground stays ground across gaps.
+    /// ...but at least this share of the ring's width (default 0.08): a plane fitted over a
+    /// larger cell misses curved ground by more.
+    pub band_per_width: f64,
+    /// Growing starts from the cells whose plane passes within this height of the nominal
+    /// ground at their centre, metres (default 0.2, the step limit).
+    pub seed_step: f64,
+    /// The allowed height difference between two cells grows by this per metre between their
+    /// ends (default 0.02), so that gently curved ground stays ground across gaps.
     pub grade: f64,
-    /// How many rings inwards the reference is looked for (default 8).
+    /// Growing jumps over at most this many rings without a candidate, and the labels look this
+    /// many rings inwards for a plane (default 8).
     pub max_gap_rings: usize,
 }
 
@@ -98,12 +130,17 @@ impl Default for GroundSettings {
             min_points: 5,
             seed_points: 20,
             seed_band: 0.15,
+            seed_band_per_width: 0.4,
             min_spread: 0.05,
-            fit_iterations: 3,
+            max_roughness: 0.03,
+            rough_height: 0.2,
+            fit_iterations: 1,
             fit_band: 0.125,
             band_sigmas: 3.0,
-            min_band: 0.08,
+            min_band: 0.02,
             max_band: 0.15,
+            band_per_width: 0.08,
+            seed_step: 0.2,
             grade: 0.02,
             max_gap_rings: 8,
         }
@@ -151,8 +188,12 @@ impl GroundSettings {
             ("fit band", self.fit_band),
             ("band sigmas", self.band_sigmas),
             ("min band", self.min_band),
+            ("seed band per width", self.seed_band_per_width),
+            ("band per width", self.band_per_width),
             ("min spread", self.min_spread),
+            ("max roughness", self.max_roughness),
             ("grade", self.grade),
+            ("seed step", self.seed_step),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(what, v, "finite, ≥ 0");
@@ -192,6 +233,11 @@ struct CellPlane {
     cy: f64,
     /// The spread across the points' main direction (square root of the middle eigenvalue).
     spread: f64,
+    /// The rms distance of the fitted points from the plane (square root of the smallest
+    /// eigenvalue).
+    roughness: f64,
+    /// Half the width of the cell's ring: how far from the centre the plane is supported.
+    reach: f64,
 }
 
 impl CellPlane {
@@ -216,9 +262,21 @@ struct PolarGrid {
     sectors: Vec<u32>,
     /// Index of each ring's first cell; one more entry with the number of cells.
     first: Vec<u32>,
-    /// Ring of range `i · lut_step` (rounded down), for the ring lookup.
-    lut: Vec<u32>,
-    lut_step: f64,
+    /// The ring of each cell.
+    ring_of: Vec<u32>,
+    /// The ring lookup by range: entry `i` covers [i, i + 1) · lut_step.
+    lut: Vec<LutEntry>,
+    /// LUT entries per metre.
+    lut_scale: f64,
+}
+
+/// One bucket of the ring lookup: the ring (first cell, sectors) below `next`, and the one from
+/// `next` on.
+#[derive(Copy, Clone, Debug)]
+struct LutEntry {
+    next: f64,
+    lo: [u32; 2],
+    hi: [u32; 2],
 }
 
 /// The diamond angle of (x, y) in [0, 4): monotone in the azimuth, no trigonometry.
@@ -279,9 +337,18 @@ impl PolarGrid {
             while ring + 1 < sectors.len() && edges[ring + 1] <= r {
                 ring += 1;
             }
-            lut.push(ring as u32);
+            // Rings are at least `lut_step` wide: a bucket reaches at most into the next one.
+            let hi = (ring + 1).min(sectors.len() - 1);
+            lut.push(LutEntry {
+                next: edges[ring + 1],
+                lo: [first[ring], sectors[ring]],
+                hi: [first[hi], sectors[hi]],
+            });
         }
-        Ok(PolarGrid { edges, sectors, first, lut, lut_step })
+        let ring_of = (0..sectors.len())
+            .flat_map(|k| std::iter::repeat_n(k as u32, sectors[k] as usize))
+            .collect();
+        Ok(PolarGrid { edges, sectors, first, ring_of, lut, lut_scale: 1.0 / lut_step })
     }
 
     fn rings(&self) -> usize {
@@ -298,12 +365,9 @@ impl PolarGrid {
         if r < self.edges[0] || r >= self.edges[self.rings()] {
             return None;
         }
-        let i = ((r / self.lut_step) as usize).min(self.lut.len() - 1);
-        let mut ring = self.lut[i] as usize;
-        while ring + 1 < self.rings() && self.edges[ring + 1] <= r {
-            ring += 1;
-        }
-        Some(self.first[ring] + self.sector(ring, a))
+        let e = &self.lut[((r * self.lut_scale) as usize).min(self.lut.len() - 1)];
+        let [first, n] = if r < e.next { e.lo } else { e.hi };
+        Some(first + ((a * 0.25 * n as f64) as u32).min(n - 1))
     }
 
     #[inline]
@@ -341,8 +405,6 @@ impl PolarGrid {
 pub struct GroundSegmenter {
     settings: GroundSettings,
     grid: PolarGrid,
-    /// Levelled z-up points, in input order.
-    levelled: Vec<[f64; 3]>,
     /// Cell of each input point (`u32::MAX`: outside the grid).
     cell_of: Vec<u32>,
     /// Start of each cell's run in `order` (`cells + 1` entries).
@@ -357,6 +419,10 @@ pub struct GroundSegmenter {
     cursor: Vec<u32>,
     /// Each cell's accepted plane.
     planes: Vec<Option<CellPlane>>,
+    /// Each cell's plane within the slope limit, accepted or not.
+    candidates: Vec<Option<CellPlane>>,
+    /// Accepted cells, in the order the growing reached them.
+    queue: Vec<u32>,
 }
 
 impl GroundSegmenter {
@@ -372,7 +438,6 @@ impl GroundSegmenter {
         Ok(GroundSegmenter {
             settings,
             grid,
-            levelled: Vec::new(),
             cell_of: Vec::new(),
             start: vec![0; cells + 1],
             order: Vec::new(),
@@ -380,6 +445,8 @@ impl GroundSegmenter {
             heights: Vec::new(),
             cursor: Vec::new(),
             planes: vec![None; cells],
+            candidates: vec![None; cells],
+            queue: Vec::new(),
         })
     }
 
@@ -435,48 +502,50 @@ impl GroundSegmenter {
             [-m[(1, 0)], -m[(1, 1)], -m[(1, 2)]],
             [-m[(2, 0)], -m[(2, 1)], -m[(2, 2)]],
         ];
-        self.levelled.clear();
+        let level = |p: &Point3<f64>| rows.map(|r| r[0] * p.x + r[1] * p.y + r[2] * p.z);
         self.cell_of.clear();
         self.start.iter_mut().for_each(|s| *s = 0);
         for p in points {
-            let q = rows.map(|r| r[0] * p.x + r[1] * p.y + r[2] * p.z);
-            let r = q[0].hypot(q[1]);
+            let q = level(p);
+            let r = (q[0] * q[0] + q[1] * q[1]).sqrt();
             let c = self.grid.cell(r, diamond_angle(q[0], q[1])).unwrap_or(u32::MAX);
             if c != u32::MAX {
                 self.start[c as usize + 1] += 1;
             }
-            self.levelled.push(q);
             self.cell_of.push(c);
         }
         for i in 1..self.start.len() {
             self.start[i] += self.start[i - 1];
         }
+        // Every slot below is overwritten: resize without clearing.
         let inside = *self.start.last().unwrap_or(&0) as usize;
-        self.order.clear();
         self.order.resize(inside, 0);
-        self.sorted.clear();
         self.sorted.resize(inside, [0.0; 3]);
         self.cursor.clear();
         self.cursor.extend_from_slice(&self.start[..self.start.len() - 1]);
-        for (i, &c) in self.cell_of.iter().enumerate() {
+        for (i, (&c, p)) in self.cell_of.iter().zip(points).enumerate() {
             if c != u32::MAX {
                 let slot = self.cursor[c as usize] as usize;
                 self.cursor[c as usize] += 1;
                 self.order[slot] = i as u32;
-                self.sorted[slot] = self.levelled[i];
+                self.sorted[slot] = level(p);
             }
         }
     }
 
-    /// Fits and accepts each cell's plane, ring by ring outwards: (cells with a fit, accepted).
+    /// Fits each cell's plane, then accepts ground by growing from the cells on the nominal
+    /// ground: (cells with enough points, accepted cells).
     fn fit_cells(&mut self, height: f64) -> (usize, usize) {
         let s = self.settings;
         let cos_max = s.limits.max_slope.cos();
-        let (mut cells, mut accepted) = (0, 0);
+        let mut cells = 0;
+        self.queue.clear();
         for ring in 0..self.grid.rings() {
+            let width = self.grid.edges[ring + 1] - self.grid.edges[ring];
             for sector in 0..self.grid.sectors[ring] {
                 let c = (self.grid.first[ring] + sector) as usize;
                 self.planes[c] = None;
+                self.candidates[c] = None;
                 let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
                 if b - a < s.min_points {
                     continue;
@@ -488,32 +557,98 @@ impl GroundSegmenter {
                 let k = s.seed_points.min(points.len() / 4).max(1);
                 self.heights.select_nth_unstable_by(k - 1, f64::total_cmp);
                 let seed = self.heights[..k].iter().sum::<f64>() / k as f64;
-                let Some(mut plane) = fit(points, &s, |p| p[2] <= seed + s.seed_band) else {
+                let seed_band = s.seed_band.min(s.seed_band_per_width * width);
+                let Some(mut plane) = fit(points, &s, |p| p[2] <= seed + seed_band) else {
                     continue;
                 };
+                let roughness = plane.roughness;
                 for _ in 0..s.fit_iterations {
-                    match fit(points, &s, |p| plane.distance(p).abs() <= s.fit_band) {
+                    let band = lower_band(points, &plane, &s);
+                    match fit(points, &s, |p| plane.distance(p).abs() <= band) {
                         Some(p) => plane = p,
                         None => break,
                     }
                 }
-                let width = self.grid.edges[ring + 1] - self.grid.edges[ring];
-                if plane.n.z < cos_max || plane.spread < s.min_spread * width {
+                plane.band =
+                    lower_band(points, &plane, &s).max(s.band_per_width * width).min(s.max_band);
+                plane.reach = 0.5 * width;
+                if plane.n.z < cos_max
+                    || plane.spread < s.min_spread * width
+                    || (roughness > s.max_roughness
+                        && plane.height_at(plane.cx, plane.cy) + height > s.rough_height)
+                {
                     continue;
                 }
-                let (reference, tolerance) = match self.reference(ring, plane.cx, plane.cy) {
-                    Some((r, gap)) => {
-                        (r.height_at(plane.cx, plane.cy), s.limits.max_step + s.grade * gap)
-                    }
-                    None => (-height, s.limits.max_step),
-                };
-                if (plane.height_at(plane.cx, plane.cy) - reference).abs() <= tolerance {
+                self.candidates[c] = Some(plane);
+                if (plane.height_at(plane.cx, plane.cy) + height).abs() <= s.seed_step {
                     self.planes[c] = Some(plane);
-                    accepted += 1;
+                    self.queue.push(c as u32);
                 }
             }
         }
+        // Grow: a candidate next to accepted ground (or across a gap of cells without a plane)
+        // is ground if the two planes meet within the step limit halfway between their centres.
+        let mut next = 0;
+        while next < self.queue.len() {
+            let c = self.queue[next] as usize;
+            next += 1;
+            let here = self.planes[c].unwrap_or_else(|| unreachable!("queued cells are accepted"));
+            let ring = self.grid.ring_of[c] as usize;
+            let sector = c as u32 - self.grid.first[ring];
+            let n = self.grid.sectors[ring];
+            for j in [(sector + n - 1) % n, (sector + 1) % n] {
+                self.try_accept(&here, (self.grid.first[ring] + j) as usize);
+            }
+            let (a0, a1) = (sector as f64 * 4.0 / n as f64, (sector + 1) as f64 * 4.0 / n as f64);
+            for up in [false, true] {
+                for d in 1..=s.max_gap_rings {
+                    let k = if up { ring + d } else { ring.wrapping_sub(d) };
+                    if k >= self.grid.rings() {
+                        break;
+                    }
+                    let nk = self.grid.sectors[k];
+                    let lo = (a0 * nk as f64 * 0.25) as u32;
+                    let hi = ((a1 * nk as f64 * 0.25).ceil() as u32).clamp(lo + 1, nk);
+                    let mut any = false;
+                    for j in lo..hi {
+                        let other = (self.grid.first[k] + j) as usize;
+                        any |= self.candidates[other].is_some();
+                        self.try_accept(&here, other);
+                    }
+                    if any {
+                        break;
+                    }
+                }
+            }
+        }
+        let accepted = self.queue.len();
         (cells, accepted)
+    }
+
+    /// Accepts candidate `other` if it meets the accepted plane `here` within the step limit
+    /// (plus the grade over the distance between them): each plane is evaluated where its own
+    /// points end towards the other (at most half a ring width from its centre, at most halfway),
+    /// so that a tilted plane is not extrapolated across a gap.
+    #[inline]
+    fn try_accept(&mut self, here: &CellPlane, other: usize) {
+        if self.planes[other].is_some() {
+            return;
+        }
+        let Some(there) = self.candidates[other] else {
+            return;
+        };
+        let (dx, dy) = (there.cx - here.cx, there.cy - here.cy);
+        let dist = dx.hypot(dy);
+        let (ux, uy) = if dist > 0.0 { (dx / dist, dy / dist) } else { (0.0, 0.0) };
+        let a = here.reach.min(0.5 * dist);
+        let b = there.reach.min(0.5 * dist);
+        let h_here = here.height_at(here.cx + a * ux, here.cy + a * uy);
+        let h_there = there.height_at(there.cx - b * ux, there.cy - b * uy);
+        let tolerance = self.settings.limits.max_step + self.settings.grade * (dist - a - b);
+        if (h_here - h_there).abs() <= tolerance {
+            self.planes[other] = Some(there);
+            self.queue.push(other as u32);
+        }
     }
 
     /// The accepted plane nearest to (x, y) among the cells at the same azimuth and its two
@@ -549,6 +684,8 @@ impl GroundSegmenter {
             cx: 0.0,
             cy: 0.0,
             spread: 0.0,
+            roughness: 0.0,
+            reach: 0.0,
         };
         let mut count = 0;
         for ring in 0..self.grid.rings() {
@@ -589,6 +726,23 @@ impl GroundSegmenter {
     }
 }
 
+/// The label band of `plane`: [`GroundSettings::band_sigmas`] times the rms distance of the
+/// points up to [`GroundSettings::fit_band`] *below* it, clamped to the band limits. Only the
+/// points below count: noise spreads ground both ways, while what stands on the ground (a
+/// wall's foot, a box, grass blades) lies above it and would widen a two-sided band.
+fn lower_band(points: &[[f64; 3]], plane: &CellPlane, s: &GroundSettings) -> f64 {
+    let (mut sum, mut n) = (0.0, 0.0);
+    for p in points {
+        let d = plane.distance(p);
+        // Branch-free: the sign of d is a coin toss on flat ground.
+        let w = f64::from(u8::from(d < 0.0 && d > -s.fit_band));
+        sum += w * d * d;
+        n += w;
+    }
+    let sigma = if n >= 3.0 { (sum / n).sqrt() } else { s.max_band };
+    (s.band_sigmas * sigma).clamp(s.min_band, s.max_band)
+}
+
 /// The least-squares plane (PCA) of the points `keep` selects, normal up, with its label band
 /// and centre; `None` for fewer than 3 points or a degenerate spread.
 fn fit(
@@ -596,30 +750,37 @@ fn fit(
     s: &GroundSettings,
     keep: impl Fn(&[f64; 3]) -> bool,
 ) -> Option<CellPlane> {
-    let (mut n, mut sum) = (0usize, [0.0; 3]);
+    // One pass of moments about the first point (cells are metres wide: no cancellation).
+    let o = *points.first()?;
+    let (mut n, mut m1, mut m2) = (0usize, [0.0; 3], [0.0; 6]);
     for p in points.iter().filter(|p| keep(p)) {
+        let (x, y, z) = (p[0] - o[0], p[1] - o[1], p[2] - o[2]);
         n += 1;
-        for k in 0..3 {
-            sum[k] += p[k];
-        }
+        m1[0] += x;
+        m1[1] += y;
+        m1[2] += z;
+        m2[0] += x * x;
+        m2[1] += x * y;
+        m2[2] += x * z;
+        m2[3] += y * y;
+        m2[4] += y * z;
+        m2[5] += z * z;
     }
     if n < 3 {
         return None;
     }
     let inv = 1.0 / n as f64;
-    let mean = sum.map(|v| v * inv);
-    let mut cov = [0.0; 6];
-    for p in points.iter().filter(|p| keep(p)) {
-        let (x, y, z) = (p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]);
-        cov[0] += x * x;
-        cov[1] += x * y;
-        cov[2] += x * z;
-        cov[3] += y * y;
-        cov[4] += y * z;
-        cov[5] += z * z;
-    }
-    let m =
-        Matrix3::new(cov[0], cov[1], cov[2], cov[1], cov[3], cov[4], cov[2], cov[4], cov[5]) * inv;
+    let c = m1.map(|v| v * inv);
+    let cov = [
+        m2[0] * inv - c[0] * c[0],
+        m2[1] * inv - c[0] * c[1],
+        m2[2] * inv - c[0] * c[2],
+        m2[3] * inv - c[1] * c[1],
+        m2[4] * inv - c[1] * c[2],
+        m2[5] * inv - c[2] * c[2],
+    ];
+    let mean = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
+    let m = Matrix3::new(cov[0], cov[1], cov[2], cov[1], cov[3], cov[4], cov[2], cov[4], cov[5]);
     let eigen = SymmetricEigen::new(m);
     let mut order = [0usize, 1, 2];
     order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
@@ -641,6 +802,8 @@ fn fit(
         cx: mean[0],
         cy: mean[1],
         spread: eigen.eigenvalues[order[1]].max(0.0).sqrt(),
+        roughness: lambda.max(0.0).sqrt(),
+        reach: 0.0,
     })
 }
 

@@ -736,6 +736,21 @@ fn section_terrain(t: Option<&TerrainSection>) -> String {
             .collect();
         out.push_str(&table(&["sector", "class", "drivable"], &rows));
     }
+    if let Some(g) = &t.ground {
+        out.push_str(&caption(
+            "Per-point ground (not in the thesis): every point labelled drivable ground or not,              from local ground planes within Rugbot's 0.2 m step and 35° slope limits; scored              against the scene's drivable surfaces.",
+        ));
+        out.push_str(&table(
+            &["ground share", "precision", "recall", "F1", "time"],
+            &[vec![
+                format!("{} %", fixed(100.0 * g.share, 1)),
+                fixed(g.precision, 3),
+                fixed(g.recall, 3),
+                fixed(g.f1, 3),
+                format!("{} ms", sig(g.millis, 3)),
+            ]],
+        ));
+    }
     out
 }
 
@@ -959,6 +974,13 @@ mod tests {
                     ("floor".into(), true),
                     ("step".into(), false),
                 ],
+                ground: Some(crate::results::GroundScore {
+                    share: 0.6,
+                    precision: 0.99,
+                    recall: 0.98,
+                    f1: 0.985,
+                    millis: 0.4,
+                }),
             }),
             maps: maps
                 .iter()

@@ -134,6 +134,24 @@ pub struct TerrainSection {
     pub hough_png: Vec<u8>,
     /// Per sector (left, centre, right): class and drivable.
     pub sectors: Vec<(String, bool)>,
+    /// Per-point ground of the snapshot (not in the thesis; absent from older results).
+    #[serde(default)]
+    pub ground: Option<GroundScore>,
+}
+
+/// The snapshot's per-point ground labels against the scene's drivable surfaces.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct GroundScore {
+    /// Share of the points labelled ground.
+    pub share: f64,
+    /// Of the points labelled ground, the share on a drivable surface.
+    pub precision: f64,
+    /// Of the points on a drivable surface, the share labelled ground.
+    pub recall: f64,
+    /// Harmonic mean of precision and recall.
+    pub f1: f64,
+    /// Labelling time, milliseconds.
+    pub millis: f64,
 }
 
 /// One map (Table 6.1).

@@ -8,6 +8,8 @@
 //! horizontal range limit), voted into the thesis's Hough space at the chosen angular
 //! resolution and classified by Algorithm 3 with the thesis's thresholds.
 
+pub mod ground;
+
 use crate::input::{self, CloudInput};
 use anyhow::{Context, Result, bail, ensure};
 use hough_terrain::{

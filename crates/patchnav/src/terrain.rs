@@ -4,6 +4,7 @@
 use crate::input::InputArgs;
 use crate::progress::Progress;
 use anyhow::Result;
+use patch_pipeline::terrain::ground::{GROUND_FIELD, GroundSetup, segment_ground};
 use patch_pipeline::terrain::{AxesChoice, Classified, TerrainSetup, class_name, classify};
 use std::path::PathBuf;
 
@@ -19,6 +20,11 @@ pub struct TerrainArgs {
     /// Also classify this many azimuth sectors (left to right) of the forward view.
     #[arg(long)]
     pub sectors: Option<usize>,
+    /// Also label every point as drivable ground or not (local ground planes within the robot's
+    /// 0.2 m step and 35° slope limits) and write the cloud with a `ground` field (u8: 1 =
+    /// ground, 0 = not) to this file (.ply or .pcd).
+    #[arg(long, value_name = "CLOUD")]
+    pub ground_out: Option<PathBuf>,
     /// Write the Hough space (thesis Fig 4.3 layout) as a PNG.
     #[arg(long, value_name = "PNG")]
     pub hough_png: Option<PathBuf>,
@@ -68,6 +74,19 @@ impl TerrainArgs {
 
 /// Runs `patchnav terrain`.
 pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
+    let classified = classify(&args.setup())?;
+    let ground = match &args.ground_out {
+        Some(out) => Some(segment_ground(&GroundSetup {
+            frame: args.frame.clone(),
+            input: args.input.input(),
+            axes: Some(classified.axes),
+            mount: Some(classified.mount),
+            out: Some(out.clone()),
+            repeat: args.repeat,
+            ..GroundSetup::new(args.frame.clone())
+        })?),
+        None => None,
+    };
     let Classified {
         cloud_points,
         points,
@@ -78,7 +97,13 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
         seconds,
         classifier,
         sectors,
-    } = classify(&args.setup())?;
+    } = classified;
+    let ground_json = ground.as_ref().map(|g| {
+        serde_json::json!({"points": g.summary.points, "ground": g.summary.ground,
+            "cells": g.summary.cells, "ground_cells": g.summary.ground_cells,
+            "first_ms": g.first() * 1e3, "best_ms": g.best() * 1e3, "median_ms": g.median() * 1e3,
+            "runs": g.times.len(), "field": GROUND_FIELD})
+    });
     if args.json {
         let sectors: Vec<_> = sectors
             .iter()
@@ -95,7 +120,7 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
             "resolution_deg": args.resolution, "class": class_name(&result), "drivable": result.drivable,
             "accepted": result.accepted, "rule": format!("{:?}", result.rule), "plane": plane,
             "votes": result.votes, "high_bins": result.high_bins, "time_ms": seconds * 1e3, "repeat": args.repeat,
-            "sectors": sectors,
+            "sectors": sectors, "ground": ground_json,
             "mount": {"height_m": height, "pitch_deg": pitch, "roll_deg": roll,
                 "estimated": estimated.map(|e| serde_json::json!({"inliers": e.inliers, "points": e.points, "rms_m": e.rms}))},
         });
@@ -145,6 +170,24 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
         space.nd(),
         if args.repeat > 1 { format!(", median of {}", args.repeat) } else { String::new() }
     ));
+    if let (Some(g), Some(out)) = (&ground, &args.ground_out) {
+        let n = g.summary.points.max(1) as f64;
+        progress.report(format!(
+            "ground:    {} of {} points ({:.1} %), {} of {} cells; {:.3} ms{} -> {} (field `{GROUND_FIELD}`, u8 1 = ground)",
+            g.summary.ground,
+            g.summary.points,
+            100.0 * g.summary.ground as f64 / n,
+            g.summary.ground_cells,
+            g.summary.cells,
+            g.best() * 1e3,
+            if g.times.len() > 1 {
+                format!(" best, {:.3} median of {} after a first of {:.3}", g.median() * 1e3, g.times.len() - 1, g.first() * 1e3)
+            } else {
+                String::new()
+            },
+            out.display()
+        ));
+    }
     for (k, s) in sectors.iter().enumerate() {
         progress.report(format!(
             "sector {k}:  azimuth {:.0}°..{:.0}° (negative = left): {}, drivable: {}",

@@ -127,6 +127,7 @@ pub fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
     let name = "terrain-hough.png";
     pointcloud::io::write_bytes_atomically(files.path(name), &png)?;
     files.add("terrain Hough space (thesis Fig 4.3 layout)", name)?;
+    let ground = terrain_ground(&scene, &cloud, &mount)?;
     let p = result.plane.context("the terrain frame gave no votes")?;
     let plane = [p.rho_x.to_degrees(), p.rho_y.to_degrees(), p.d];
     Ok(TerrainSection {
@@ -140,6 +141,41 @@ pub fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
         points: result.points,
         hough_png: png,
         sectors,
+        ground: Some(ground),
+    })
+}
+
+/// The snapshot's per-point ground ([`hough_terrain::GroundSegmenter`]) scored against the
+/// scene's drivable surfaces: the floor, and the ramp and its platform if passable.
+fn terrain_ground(
+    scene: &scene_sim::Scene,
+    cloud: &pointcloud::PointCloud,
+    mount: &SensorMount,
+) -> Result<crate::results::GroundScore> {
+    let passable = scene.terrain_truth().is_some_and(|t| t.passable);
+    let drivable: Vec<bool> = scene
+        .surfaces()
+        .iter()
+        .map(|s| {
+            s.name == "floor" || (passable && ["ramp", "platform/+z"].contains(&s.name.as_str()))
+        })
+        .collect();
+    let labels = cloud.labels().context("the snapshot has surface labels")?;
+    let truth: Vec<Option<bool>> =
+        labels.iter().map(|&l| Some(drivable.get(l as usize).copied().unwrap_or(false))).collect();
+    let mut segmenter =
+        hough_terrain::GroundSegmenter::new(hough_terrain::GroundSettings::default())?;
+    let mut ground = Vec::new();
+    let t0 = Instant::now();
+    let summary = segmenter.segment(cloud.positions(), mount, &mut ground)?;
+    let millis = t0.elapsed().as_secs_f64() * 1e3;
+    let s = evaluation::peers::ground::score(&ground, &truth)?;
+    Ok(crate::results::GroundScore {
+        share: summary.ground as f64 / summary.points.max(1) as f64,
+        precision: s.precision(),
+        recall: s.recall(),
+        f1: s.f1(),
+        millis,
     })
 }
 

@@ -577,6 +577,8 @@ fn terrain(t: &TerrainConfig, files: &mut Files) -> Result<TerrainSection> {
             .iter()
             .map(|s| (class(s.classification.class), s.classification.drivable))
             .collect(),
+        // The user's frame has no per-point truth to score ground labels against.
+        ground: None,
     })
 }
 
