@@ -204,3 +204,17 @@ mod tests {
         assert!(segment_ground(&GroundSetup { repeat: 0, ..setup }).is_err());
     }
 }
+
+#[cfg(test)]
+mod demo_tests {
+    /// The demo's terrain snapshot (a passable 30° ramp) scores its ground labels.
+    #[test]
+    fn the_demo_snapshot_scores_its_ground() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut files = crate::demo::Files::new(dir.path());
+        let t = crate::demo::sensors::terrain(1, &mut files).unwrap();
+        let g = t.ground.unwrap();
+        assert!(g.share > 0.3, "{g:?}");
+        assert!(g.f1 > 0.95, "{g:?}");
+    }
+}
