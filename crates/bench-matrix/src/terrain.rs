@@ -17,7 +17,7 @@ mod speed;
 mod synthetic;
 mod thesis;
 
-use synthetic::{CaseResult, Outcome, RESOLUTIONS, Sensor};
+use synthetic::{CaseResult, METHODS, Outcome, RESOLUTIONS, Sensor};
 
 /// Snapshots per parameter set by default.
 const DEFAULT_SNAPSHOTS: usize = 20;
@@ -62,7 +62,12 @@ pub fn run(seed: u64) -> Result<Vec<Value>> {
             thesis::TABLE_4_7_MEAN,
         ),
     ] {
-        eprintln!("{}", class_table(&results, sensor, title, thesis_rows, printed, &mut rows));
+        for method in METHODS {
+            eprintln!(
+                "{}",
+                class_table(&results, method, sensor, title, thesis_rows, printed, &mut rows)
+            );
+        }
     }
     rows.extend(real::run()?);
     rows.extend(speed::run(seed)?);
@@ -131,13 +136,13 @@ fn fmt_drive(d: &Drive) -> String {
 fn table_4_3(results: &[CaseResult], rows: &mut Vec<Value>) -> String {
     let mut s = String::from(
         "Table 4.3: drivability at 45° (success / FN / FP / ms per snapshot), ours on simulated snapshots beside \
-         the thesis's datasets\n| sensor | ours | snapshots (excluded) | mean points | thesis Arena | thesis Outdoor 1 | \
-         thesis Outdoor 2 | thesis Outdoor 3 |\n|---|---|---|---|---|---|---|---|\n",
+         the thesis's datasets\n| sensor | method | ours | snapshots (excluded) | mean points | thesis Arena | thesis Outdoor 1 | \
+         thesis Outdoor 2 | thesis Outdoor 3 |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    for sensor in Sensor::ALL {
+    for (sensor, method) in Sensor::ALL.into_iter().flat_map(|s| METHODS.map(|m| (s, m))) {
         let items: Vec<(bool, Outcome)> = results
             .iter()
-            .filter(|r| r.sensor == sensor)
+            .filter(|r| r.sensor == sensor && r.method == method)
             .flat_map(|r| r.outcomes[0].iter().map(|o| (r.case.passable, *o)))
             .collect();
         let d = score_drive(&items);
@@ -161,7 +166,7 @@ fn table_4_3(results: &[CaseResult], rows: &mut Vec<Value>) -> String {
             .collect();
         let excluded = 1.0 - d.accepted as f64 / d.snapshots.max(1) as f64;
         s += &format!(
-            "| {} | {} | {} ({:.0} %) | {:.0} | {} |\n",
+            "| {} | {method} | {} | {} ({:.0} %) | {:.0} | {} |\n",
             sensor.name(),
             fmt_drive(&d),
             d.snapshots,
@@ -176,8 +181,11 @@ fn table_4_3(results: &[CaseResult], rows: &mut Vec<Value>) -> String {
             ("time_per_snapshot", d.ms, "ms"),
             ("excluded", excluded, "share"),
         ] {
-            rows.push(json!({"case": format!("sim/{}", sensor.name()), "metric": metric, "value": value,
-                "unit": unit, "resolution_deg": 45, "snapshots": d.snapshots, "mean_points": d.points}));
+            rows.push(
+                json!({"case": format!("sim/{}", sensor.name()), "method": method, "metric": metric,
+                "value": value, "unit": unit, "resolution_deg": 45, "snapshots": d.snapshots,
+                "mean_points": d.points}),
+            );
         }
     }
     s += "Thesis: success 83–100 %, stereo 98–100 %, 5–50 ms per frame (hardware not stated).";
@@ -186,6 +194,7 @@ fn table_4_3(results: &[CaseResult], rows: &mut Vec<Value>) -> String {
 
 fn class_table(
     results: &[CaseResult],
+    method: &str,
     sensor: Sensor,
     title: &str,
     thesis_rows: &[thesis::SceneRow],
@@ -193,12 +202,12 @@ fn class_table(
     rows: &mut Vec<Value>,
 ) -> String {
     let mut s = format!(
-        "{title}: classification rate / ms per snapshot at 45° | 15° | 9°\n| set | label | snapshots | mean points | \
+        "{title}, method {method}: classification rate / ms per snapshot at 45° | 15° | 9°\n| set | label | snapshots | mean points | \
          drivable | @45° | @15° | @9° |\n|---|---|---|---|---|---|---|---|\n"
     );
     let mut sums = [(0.0, 0.0); 3];
     let mut count = 0usize;
-    for r in results.iter().filter(|r| r.sensor == sensor) {
+    for r in results.iter().filter(|r| r.sensor == sensor && r.method == method) {
         let cols: Vec<(f64, f64)> =
             r.outcomes.iter().map(|o| class_rate(r.case.label, o)).collect();
         let points = r.outcomes[0].iter().map(|o| o.points as f64).sum::<f64>()
@@ -218,7 +227,8 @@ fn class_table(
         for (k, (rate, ms)) in cols.iter().enumerate() {
             sums[k].0 += rate;
             sums[k].1 += ms;
-            rows.push(json!({"case": format!("sim/{}/{}", sensor.name(), r.case.name), "metric": "class_rate",
+            rows.push(json!({"case": format!("sim/{}/{}", sensor.name(), r.case.name), "method": method,
+                "metric": "class_rate",
                 "value": rate, "unit": "share", "resolution_deg": RESOLUTIONS[k], "ms": ms,
                 "label": format!("{:?}", r.case.label), "snapshots": r.outcomes[k].len(), "mean_points": points}));
         }
@@ -231,7 +241,7 @@ fn class_table(
         })
         .collect();
     for (k, (r, t)) in sums.iter().enumerate() {
-        rows.push(json!({"case": format!("sim/{}", sensor.name()), "metric": "class_rate_mean",
+        rows.push(json!({"case": format!("sim/{}", sensor.name()), "method": method, "metric": "class_rate_mean",
             "value": r / count.max(1) as f64, "unit": "share", "resolution_deg": RESOLUTIONS[k],
             "ms": t / count.max(1) as f64, "thesis_printed": printed[k].0}));
     }
@@ -239,7 +249,7 @@ fn class_table(
         m.iter().map(|(r, t)| format!("{r:.2}/{t:.1}")).collect::<Vec<_>>().join(" | ")
     };
     let true_mean = thesis::column_means(thesis_rows, thesis_rows.len() as f64);
-    s += &format!("| **ours, mean of {count} sets** | | | | | {} |\n", ours.join(" | "));
+    s += &format!("| **ours ({method}), mean of {count} sets** | | | | | {} |\n", ours.join(" | "));
     s += &format!("| thesis, printed mean | | | | | {} |\n", fmt3(printed));
     s += &format!(
         "| thesis, true mean of its {} scenes | | | | | {} |",

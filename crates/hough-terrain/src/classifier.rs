@@ -1,6 +1,7 @@
 //! The streaming classifier: prepared once, then one call per frame reusing every buffer.
 
 use crate::accumulator::{Accumulator, NormalTable};
+use crate::ahead::{AheadScratch, GroundAhead, classify_ahead};
 use crate::classify::{Classification, ClassifierConfig, algorithm3, floor_bin, rejected};
 use crate::error::{HoughError, Result};
 use crate::mount::SensorMount;
@@ -21,16 +22,90 @@ pub struct HoughConfig {
     /// Voting threads: 1 votes on the caller's thread without allocating; more splits the
     /// points over scoped threads.
     pub threads: usize,
+    /// Which rule turns the frame into a class.
+    pub method: Method,
 }
 
 impl HoughConfig {
-    /// The thesis's space at `resolution` (radians), the thesis's classifier, one thread.
+    /// The thesis's space at `resolution` (radians), the thesis's classifier (Algorithm 3),
+    /// one thread: the thesis's tables.
     pub fn thesis(resolution: f64, mount: SensorMount) -> Result<HoughConfig> {
         Ok(HoughConfig {
             space: HoughSpace::thesis(resolution)?,
             mount,
             classifier: ClassifierConfig::thesis(),
             threads: 1,
+            method: Method::Thesis,
+        })
+    }
+
+    /// [`HoughConfig::thesis`] with the ground-ahead rule ([`crate::ahead`]) deciding: the
+    /// recommended configuration.
+    pub fn recommended(resolution: f64, mount: SensorMount) -> Result<HoughConfig> {
+        Ok(HoughConfig {
+            method: Method::GroundAhead(GroundAhead::recommended()),
+            ..HoughConfig::thesis(resolution, mount)?
+        })
+    }
+}
+
+/// Which rule turns a frame into a class. The Hough space is filled either way (for its
+/// picture and the thesis's plane).
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "a plain configuration value, copied once per classifier"
+)]
+pub enum Method {
+    /// Algorithm 3 verbatim (§4.1.3, L3468–3520): the thesis's tables.
+    Thesis,
+    /// The ground-ahead rule ([`crate::ahead`]), beyond the thesis; the recommended one.
+    GroundAhead(GroundAhead),
+}
+
+impl Method {
+    /// Every method with its default parameters, the recommended first.
+    pub const NAMES: [&'static str; 2] = ["ground-ahead", "thesis"];
+
+    /// The method's name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Thesis => "thesis",
+            Method::GroundAhead(_) => "ground-ahead",
+        }
+    }
+
+    /// One line on what the method is, for help texts.
+    pub fn description(&self) -> &'static str {
+        match self {
+            Method::Thesis => "Algorithm 3 of the thesis, verbatim (its tables)",
+            Method::GroundAhead(_) => {
+                "what stands on the ground or lies ahead, within the robot's step and slope limits"
+            }
+        }
+    }
+
+    /// Every method with its default parameters, the recommended first.
+    pub fn all() -> [Method; 2] {
+        [Method::GroundAhead(GroundAhead::recommended()), Method::Thesis]
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = HoughError;
+
+    /// A method by name, with its default parameters.
+    fn from_str(s: &str) -> Result<Method> {
+        Method::all().into_iter().find(|m| m.name() == s).ok_or_else(|| HoughError::UnknownName {
+            what: "terrain method",
+            name: s.to_owned(),
+            allowed: Method::NAMES.join(", "),
         })
     }
 }
@@ -47,6 +122,7 @@ pub struct HoughClassifier {
     acc: Accumulator,
     partials: Vec<Accumulator>,
     levelled: Vec<Point3<f64>>,
+    ahead: AheadScratch,
 }
 
 impl HoughClassifier {
@@ -54,6 +130,9 @@ impl HoughClassifier {
     /// on 0 threads, or if the floor has no bin ([`floor_bin`]).
     pub fn new(config: HoughConfig) -> Result<HoughClassifier> {
         config.classifier.validate()?;
+        if let Method::GroundAhead(rule) = &config.method {
+            rule.validate()?;
+        }
         if config.threads == 0 || config.threads > 1024 {
             return Err(HoughError::BadParameter {
                 what: "threads",
@@ -67,6 +146,7 @@ impl HoughClassifier {
             acc: Accumulator::new(config.space),
             partials: Vec::new(),
             levelled: Vec::new(),
+            ahead: AheadScratch::default(),
             floor,
             config,
         })
@@ -97,6 +177,12 @@ impl HoughClassifier {
         self.acc.capacity_bytes()
             + self.partials.iter().map(Accumulator::capacity_bytes).sum::<usize>()
             + self.levelled.capacity() * std::mem::size_of::<Point3<f64>>()
+            + self.ahead.capacity_bytes()
+    }
+
+    /// What the ground-ahead rule saw in the last frame (all zero under [`Method::Thesis`]).
+    pub fn ahead_facts(&self) -> crate::ahead::AheadFacts {
+        self.ahead.facts
     }
 
     /// Classifies a frame of sensor-frame points; the frame size for the preprocessing test is
@@ -136,7 +222,21 @@ impl HoughClassifier {
         } else {
             self.table.vote(&self.levelled, &mut self.acc)?;
         }
-        let mut c = algorithm3(&self.acc, self.floor, &self.config.classifier)?;
+        let mut c = match &self.config.method {
+            Method::Thesis => algorithm3(&self.acc, self.floor, &self.config.classifier)?,
+            Method::GroundAhead(rule) => {
+                let mut c = classify_ahead(
+                    &self.levelled,
+                    self.config.mount.height(),
+                    &self.config.classifier.limits,
+                    rule,
+                    &mut self.ahead,
+                )?;
+                c.floor_votes = self.acc.count(self.floor);
+                c.points = valid;
+                c
+            }
+        };
         c.valid_fraction = fraction;
         Ok(c)
     }

@@ -157,6 +157,19 @@ pub enum Rule {
     NoVotes,
     /// The preprocessing test failed: not classified, reported as a non-drivable obstacle.
     Rejected,
+    /// Ground-ahead rule ([`crate::ahead`]): nothing stands and no other surface lies ahead:
+    /// floor.
+    AheadFloor,
+    /// Ground-ahead rule: a surface other than the floor lies ahead and decides (ramp, plateau,
+    /// canyon, or floor for a step the robot can take).
+    AheadSurface,
+    /// Ground-ahead rule: something higher than the robot's step stands ahead: obstacle.
+    AheadObstacle,
+    /// Ground-ahead rule: too few points ahead to tell: obstacle.
+    AheadTooFew,
+    /// Ground-ahead rule: the ground ends ahead and what lies beyond is out of a step's reach:
+    /// canyon.
+    AheadDrop,
 }
 
 /// The result of classifying one frame (or one sector).

@@ -76,6 +76,16 @@ pub enum HoughError {
         /// The tilt limit, degrees.
         max_tilt_deg: f64,
     },
+    /// A name (of a method) that is not known.
+    #[error("unknown {what} `{name}` (known: {allowed})")]
+    UnknownName {
+        /// What was named.
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The known names.
+        allowed: String,
+    },
     /// Writing the histogram image.
     #[error("writing PNG: {0}")]
     Png(String),

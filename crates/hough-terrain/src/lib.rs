@@ -63,6 +63,7 @@
 //! | drivability (Table 4.3, L3908–3922) | [`Classification::drivable`] |
 //! | histogram pictures (Fig 4.3, L3689–3705) | [`hough_png`], [`hough_image`] |
 //! | timing (Fig 4.4, 5–50 ms per frame) | `benches/hough.rs` |
+//! | beyond: the ground-ahead rule (what stands on the ground or lies ahead, within the robot's limits) | [`Method::GroundAhead`], [`GroundAhead`], [`classify_ahead`] |
 //! | beyond: per-sector classification | [`SectorClassifier`], [`SectorGrid`] |
 //! | beyond: equal-area ball accumulator (Borrmann et al. 2011) | [`BallAccumulator`], [`refine_plane`] |
 //! | beyond: mount self-calibration (height, pitch, roll from the ground plane; one frame or a running window) | [`estimate_mount`], [`MountSearch`], [`MountWindow`] |
@@ -107,6 +108,7 @@
 //! [0, 1] or a floor without a bin are typed errors ([`HoughError`]).
 
 pub mod accumulator;
+pub mod ahead;
 pub mod ball;
 pub mod calibrate;
 pub mod classifier;
@@ -119,9 +121,10 @@ pub mod sectors;
 pub mod space;
 
 pub use accumulator::{Accumulator, NormalTable, vote_literal};
+pub use ahead::{AheadFacts, GroundAhead, classify_ahead};
 pub use ball::{BallAccumulator, BallConfig, BallPlane, refine_plane};
 pub use calibrate::{MountEstimate, MountSearch, MountWindow, estimate_mount};
-pub use classifier::{HoughClassifier, HoughConfig};
+pub use classifier::{HoughClassifier, HoughConfig, Method};
 pub use classify::{
     BinType, Classification, ClassifierConfig, Preprocessing, RobotLimits, Rule, TerrainClass,
     Thresholds, algorithm3, bin_type, floor_bin,

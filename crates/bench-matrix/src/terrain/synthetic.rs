@@ -8,7 +8,7 @@
 //! the feature's distance (spread evenly over ±0.25 m around the nominal one).
 
 use anyhow::{Context, Result};
-use hough_terrain::{HoughClassifier, HoughConfig, SensorAxes, SensorMount, TerrainClass};
+use hough_terrain::{HoughClassifier, HoughConfig, Method, SensorAxes, SensorMount, TerrainClass};
 use nalgebra::Point3;
 use scene_sim::{HoughClass, RangeSensor, Scene, SceneBuilder, StereoCamera, TerrainSpec, terrain};
 use sensor_tof::sim::{SimConfig, SunRegion, TofSimulator};
@@ -284,8 +284,10 @@ pub(crate) struct Outcome {
     pub seconds: f64,
 }
 
-/// Per sensor × case: outcomes per resolution, one per snapshot.
+/// Per method × sensor × case: outcomes per resolution, one per snapshot.
 pub(crate) struct CaseResult {
+    /// The classification method.
+    pub method: &'static str,
     /// The sensor.
     pub sensor: Sensor,
     /// The parameter set.
@@ -294,12 +296,31 @@ pub(crate) struct CaseResult {
     pub outcomes: [Vec<Outcome>; 3],
 }
 
-/// Runs every case for every sensor with `n` snapshots each.
+/// The methods compared: the ground-ahead rule (recommended) and the thesis's Algorithm 3.
+pub(crate) const METHODS: [&str; 2] = ["ground-ahead", "thesis"];
+
+/// Runs every case for every sensor with `n` snapshots each, classified by every method of
+/// [`METHODS`] at every resolution. With `PATCHNAV_TERRAIN_DEBUG` set, the ground-ahead rule's
+/// wrong drivability calls at 45° are printed with what it saw.
 pub(crate) fn run_all(n: usize, seed: u64) -> Result<Vec<CaseResult>> {
     let mount = mount()?;
-    let mut cls = RESOLUTIONS
+    let debug = std::env::var_os("PATCHNAV_TERRAIN_DEBUG");
+    let all = debug.as_deref() == Some(std::ffi::OsStr::new("all"));
+    let debug = debug.is_some();
+    let mut methods = METHODS
         .iter()
-        .map(|r| Ok(HoughClassifier::new(HoughConfig::thesis(r.to_radians(), mount)?)?))
+        .map(|name| {
+            let method: Method = name.parse()?;
+            let cls = RESOLUTIONS
+                .iter()
+                .map(|r| {
+                    let config =
+                        HoughConfig { method, ..HoughConfig::thesis(r.to_radians(), mount)? };
+                    Ok(HoughClassifier::new(config)?)
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok((*name, cls))
+        })
         .collect::<Result<Vec<_>>>()?;
     let cases = cases();
     let mut results = Vec::new();
@@ -308,25 +329,45 @@ pub(crate) fn run_all(n: usize, seed: u64) -> Result<Vec<CaseResult>> {
         let mut maker = FrameMaker::new(sensor)?;
         let n_sensor = if sensor == Sensor::Stereo { n.div_ceil(2) } else { n };
         for case in &cases {
-            let mut outcomes: [Vec<Outcome>; 3] = Default::default();
+            let mut outcomes: Vec<[Vec<Outcome>; 3]> = vec![Default::default(); methods.len()];
             for k in 0..n_sensor {
                 let scene = scene(case, k, n_sensor, seed)?;
                 let pixels =
                     maker.frame(&scene, seed.wrapping_add(k as u64 * 7919), &mut points)?;
-                for (c, out) in cls.iter_mut().zip(outcomes.iter_mut()) {
-                    let t = Instant::now();
-                    let r = c.classify_frame(&points, pixels)?;
-                    let seconds = t.elapsed().as_secs_f64();
-                    out.push(Outcome {
-                        class: r.class,
-                        drivable: r.drivable,
-                        accepted: r.accepted,
-                        points: r.points,
-                        seconds,
-                    });
+                for ((name, cls), per_method) in methods.iter_mut().zip(outcomes.iter_mut()) {
+                    for (i, (c, out)) in cls.iter_mut().zip(per_method.iter_mut()).enumerate() {
+                        let t = Instant::now();
+                        let r = c.classify_frame(&points, pixels)?;
+                        let seconds = t.elapsed().as_secs_f64();
+                        if debug
+                            && i == 0
+                            && *name == "ground-ahead"
+                            && (all || r.drivable != case.passable)
+                        {
+                            eprintln!(
+                                "{} {} #{k}: {:?} {:?} step {:.2} tilt {:.1}° {:?}",
+                                sensor.name(),
+                                case.name,
+                                r.class,
+                                r.rule,
+                                r.step,
+                                r.tilt.to_degrees(),
+                                c.ahead_facts()
+                            );
+                        }
+                        out.push(Outcome {
+                            class: r.class,
+                            drivable: r.drivable,
+                            accepted: r.accepted,
+                            points: r.points,
+                            seconds,
+                        });
+                    }
                 }
             }
-            results.push(CaseResult { sensor, case: case.clone(), outcomes });
+            for ((name, _), outcomes) in methods.iter().zip(outcomes) {
+                results.push(CaseResult { method: name, sensor, case: case.clone(), outcomes });
+            }
         }
     }
     Ok(results)

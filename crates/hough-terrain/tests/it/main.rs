@@ -1,5 +1,6 @@
 //! Integration tests of `hough-terrain`, one binary (`cargo test -p hough-terrain --test it`).
 
+mod ahead;
 mod algorithm3;
 mod ball;
 mod common;
