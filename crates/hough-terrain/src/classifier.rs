@@ -24,6 +24,8 @@ pub struct HoughConfig {
     pub threads: usize,
     /// Which rule turns the frame into a class.
     pub method: Method,
+    /// The ground-ahead rule's parameters (used by [`Method::GroundAhead`]).
+    pub ahead: GroundAhead,
 }
 
 impl HoughConfig {
@@ -36,58 +38,47 @@ impl HoughConfig {
             classifier: ClassifierConfig::thesis(),
             threads: 1,
             method: Method::Thesis,
+            ahead: GroundAhead::recommended(),
         })
     }
 
     /// [`HoughConfig::thesis`] with the ground-ahead rule ([`crate::ahead`]) deciding: the
     /// recommended configuration.
     pub fn recommended(resolution: f64, mount: SensorMount) -> Result<HoughConfig> {
-        Ok(HoughConfig {
-            method: Method::GroundAhead(GroundAhead::recommended()),
-            ..HoughConfig::thesis(resolution, mount)?
-        })
+        Ok(HoughConfig { method: Method::GroundAhead, ..HoughConfig::thesis(resolution, mount)? })
     }
 }
 
-/// Which rule turns a frame into a class. The Hough space is filled either way (for its
-/// picture and the thesis's plane).
-#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "a plain configuration value, copied once per classifier"
-)]
+/// Which rule turns a frame into a class.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Method {
+    /// The ground-ahead rule ([`crate::ahead`]), beyond the thesis; the recommended one.
+    GroundAhead,
     /// Algorithm 3 verbatim (§4.1.3, L3468–3520): the thesis's tables.
     Thesis,
-    /// The ground-ahead rule ([`crate::ahead`]), beyond the thesis; the recommended one.
-    GroundAhead(GroundAhead),
 }
 
 impl Method {
-    /// Every method with its default parameters, the recommended first.
-    pub const NAMES: [&'static str; 2] = ["ground-ahead", "thesis"];
+    /// Every method, the recommended first.
+    pub const ALL: [Method; 2] = [Method::GroundAhead, Method::Thesis];
 
-    /// The method's name.
-    pub fn name(&self) -> &'static str {
+    /// The method's name (what [`std::str::FromStr`] parses).
+    pub fn name(self) -> &'static str {
         match self {
+            Method::GroundAhead => "ground-ahead",
             Method::Thesis => "thesis",
-            Method::GroundAhead(_) => "ground-ahead",
         }
     }
 
     /// One line on what the method is, for help texts.
-    pub fn description(&self) -> &'static str {
+    pub fn description(self) -> &'static str {
         match self {
-            Method::Thesis => "Algorithm 3 of the thesis, verbatim (its tables)",
-            Method::GroundAhead(_) => {
-                "what stands on the ground or lies ahead, within the robot's step and slope limits"
+            Method::GroundAhead => {
+                "what stands on the ground, the surface ahead and where the ground drops away, \
+                 within the robot's step and slope limits"
             }
+            Method::Thesis => "Algorithm 3 of the thesis, verbatim (its tables)",
         }
-    }
-
-    /// Every method with its default parameters, the recommended first.
-    pub fn all() -> [Method; 2] {
-        [Method::GroundAhead(GroundAhead::recommended()), Method::Thesis]
     }
 }
 
@@ -100,12 +91,11 @@ impl std::fmt::Display for Method {
 impl std::str::FromStr for Method {
     type Err = HoughError;
 
-    /// A method by name, with its default parameters.
     fn from_str(s: &str) -> Result<Method> {
-        Method::all().into_iter().find(|m| m.name() == s).ok_or_else(|| HoughError::UnknownName {
+        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| HoughError::UnknownName {
             what: "terrain method",
             name: s.to_owned(),
-            allowed: Method::NAMES.join(", "),
+            allowed: Method::ALL.map(Method::name).join(", "),
         })
     }
 }
@@ -130,8 +120,8 @@ impl HoughClassifier {
     /// on 0 threads, or if the floor has no bin ([`floor_bin`]).
     pub fn new(config: HoughConfig) -> Result<HoughClassifier> {
         config.classifier.validate()?;
-        if let Method::GroundAhead(rule) = &config.method {
-            rule.validate()?;
+        if config.method == Method::GroundAhead {
+            config.ahead.validate()?;
         }
         if config.threads == 0 || config.threads > 1024 {
             return Err(HoughError::BadParameter {
@@ -162,7 +152,8 @@ impl HoughClassifier {
         self.floor
     }
 
-    /// The accumulator of the last frame (empty if it was rejected).
+    /// The accumulator of the last frame (empty if it was rejected, or under the ground-ahead
+    /// rule without [`GroundAhead::hough`]).
     pub fn accumulator(&self) -> &Accumulator {
         &self.acc
     }
@@ -212,7 +203,10 @@ impl HoughClassifier {
         if !self.config.classifier.preprocessing.accepts(valid, frame_pixels) {
             return Ok(rejected(valid, fraction));
         }
-        if self.config.threads > 1 {
+        let vote = self.config.method == Method::Thesis || self.config.ahead.hough;
+        if !vote {
+            // The ground-ahead rule alone: the Hough space stays empty.
+        } else if self.config.threads > 1 {
             self.table.vote_parallel(
                 &self.levelled,
                 &mut self.acc,
@@ -222,14 +216,14 @@ impl HoughClassifier {
         } else {
             self.table.vote(&self.levelled, &mut self.acc)?;
         }
-        let mut c = match &self.config.method {
+        let mut c = match self.config.method {
             Method::Thesis => algorithm3(&self.acc, self.floor, &self.config.classifier)?,
-            Method::GroundAhead(rule) => {
+            Method::GroundAhead => {
                 let mut c = classify_ahead(
                     &self.levelled,
                     self.config.mount.height(),
                     &self.config.classifier.limits,
-                    rule,
+                    &self.config.ahead,
                     &mut self.ahead,
                 )?;
                 c.floor_votes = self.acc.count(self.floor);

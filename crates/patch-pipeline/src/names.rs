@@ -94,6 +94,18 @@ impl Named for Backend {
     }
 }
 
+impl Named for hough_terrain::Method {
+    const ALL: &'static [hough_terrain::Method] = &hough_terrain::Method::ALL;
+
+    fn name(self) -> &'static str {
+        hough_terrain::Method::name(self)
+    }
+
+    fn description(self) -> &'static str {
+        hough_terrain::Method::description(self)
+    }
+}
+
 impl Named for PlannerKind {
     const ALL: &'static [PlannerKind] = &PlannerKind::ALL;
 

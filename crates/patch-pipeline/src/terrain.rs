@@ -6,9 +6,12 @@
 //! ([`SensorMount::looking_ahead`]), given or estimated from the frame's ground plane
 //! ([`estimate_mount`]: height, pitch and roll), optionally cut to the forward view (±45° of azimuth, a
 //! horizontal range limit), voted into the thesis's Hough space at the chosen angular
-//! resolution and classified by Algorithm 3 with the thesis's thresholds.
+//! resolution and classified by the chosen [`Method`]: the ground-ahead rule (the default) or
+//! Algorithm 3 with the thesis's thresholds. Sectors are always classified by Algorithm 3.
 
 pub mod ground;
+
+pub use hough_terrain::Method;
 
 use crate::input::{self, CloudInput};
 use anyhow::{Context, Result, bail, ensure};
@@ -39,6 +42,8 @@ pub struct TerrainSetup {
     /// Angular resolution of the Hough space, degrees (thesis: 45 for drivability, 15 or 9 for
     /// classes).
     pub resolution: f64,
+    /// Which rule decides: the ground-ahead rule (recommended) or Algorithm 3 verbatim.
+    pub method: Method,
     /// Also classify this many azimuth sectors (left to right) of the forward view.
     pub sectors: Option<usize>,
     /// Write the Hough space (thesis Fig 4.3 layout) as a PNG.
@@ -67,6 +72,7 @@ impl TerrainSetup {
         TerrainSetup {
             frame,
             resolution: 15.0,
+            method: Method::GroundAhead,
             sectors: None,
             hough_png: None,
             axes: None,
@@ -174,7 +180,10 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
             args.frame.display()
         );
     }
-    let config = HoughConfig::thesis(args.resolution.to_radians(), mount)?;
+    let mut config = HoughConfig::thesis(args.resolution.to_radians(), mount)?;
+    config.method = args.method;
+    // The Hough space is filled under either method: `Classified` holds it for its picture.
+    config.ahead.hough = true;
     let mut classifier = HoughClassifier::new(config)?;
     let mut times = Vec::with_capacity(args.repeat);
     let mut result = None;

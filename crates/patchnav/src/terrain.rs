@@ -5,7 +5,7 @@ use crate::input::InputArgs;
 use crate::progress::Progress;
 use anyhow::Result;
 use patch_pipeline::terrain::ground::{GROUND_FIELD, GroundSetup, segment_ground};
-use patch_pipeline::terrain::{AxesChoice, Classified, TerrainSetup, class_name, classify};
+use patch_pipeline::terrain::{AxesChoice, Classified, Method, TerrainSetup, class_name, classify};
 use std::path::PathBuf;
 
 /// Arguments of `patchnav terrain`.
@@ -17,6 +17,10 @@ pub struct TerrainArgs {
     /// classes).
     #[arg(long, default_value_t = 15.0)]
     pub resolution: f64,
+    /// Which rule decides the class: the ground-ahead rule, or the thesis's Algorithm 3
+    /// verbatim (its tables).
+    #[arg(long, default_value = "ground-ahead", value_parser = crate::names::all::<Method>())]
+    pub method: Method,
     /// Also classify this many azimuth sectors (left to right) of the forward view.
     #[arg(long)]
     pub sectors: Option<usize>,
@@ -60,6 +64,7 @@ impl TerrainArgs {
         TerrainSetup {
             frame: self.frame.clone(),
             resolution: self.resolution,
+            method: self.method,
             sectors: self.sectors,
             hough_png: self.hough_png.clone(),
             axes: self.axes,

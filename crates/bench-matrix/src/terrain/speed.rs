@@ -4,7 +4,7 @@
 //! Algorithm 2 ([`hough_terrain::vote_literal`]).
 
 use anyhow::{Result, ensure};
-use hough_terrain::{Accumulator, HoughClassifier, HoughConfig, NormalTable, vote_literal};
+use hough_terrain::{Accumulator, HoughClassifier, HoughConfig, Method, NormalTable, vote_literal};
 use nalgebra::Point3;
 use scene_sim::{RangeCamera, RangeSensor, StereoCamera, TerrainSpec, terrain};
 use serde_json::{Value, json};
@@ -92,5 +92,51 @@ pub(crate) fn run(seed: u64) -> Result<Vec<Value>> {
     table += "Thesis Fig 4.4: about 0.47 µs per point (SR) and 0.75 µs per point (STOC) at 45°, hardware not stated. \
               RANSAC ground plane on the same frames: `cargo xtask peers terrain`.";
     eprintln!("{table}");
+    eprintln!("{}", ahead_speed(seed, &mut rows)?);
     Ok(rows)
+}
+
+/// The ground-ahead rule's time per frame (levelling, preprocessing, Algorithm 2 for the
+/// Hough space, the rule) beside Algorithm 3's, on every simulated frame kind of the
+/// benchmark: the wall frame of [`frames`] and one frame of each sensor of each parameter set.
+fn ahead_speed(seed: u64, rows: &mut Vec<Value>) -> Result<String> {
+    let mount = super::synthetic::mount()?;
+    let mut table = String::from(
+        "Speed of the methods at 45° (one thread): median ms per frame over one frame of every parameter set\n\
+         | sensor | method | median ms | max ms | frames |\n|---|---|---|---|---|\n",
+    );
+    let cases = super::synthetic::cases();
+    for sensor in super::synthetic::Sensor::ALL {
+        let mut maker = super::synthetic::FrameMaker::new(sensor)?;
+        let mut frames = Vec::new();
+        for case in &cases {
+            let scene = super::synthetic::scene(case, 0, 1, seed)?;
+            let mut points = Vec::new();
+            let pixels = maker.frame(&scene, seed, &mut points)?;
+            frames.push((points, pixels));
+        }
+        for name in super::synthetic::METHODS {
+            let method: Method = name.parse()?;
+            let config = HoughConfig { method, ..HoughConfig::thesis(45f64.to_radians(), mount)? };
+            let mut c = HoughClassifier::new(config)?;
+            let mut times = Vec::new();
+            for (points, pixels) in &frames {
+                times.push(crate::median_seconds(21, || {
+                    std::hint::black_box(c.classify_frame(points, *pixels)?);
+                    Ok(())
+                })?);
+            }
+            times.sort_by(f64::total_cmp);
+            let (median, max) = (times[times.len() / 2] * 1e3, times[times.len() - 1] * 1e3);
+            table += &format!(
+                "| {} | {name} | {median:.3} | {max:.3} | {} |\n",
+                sensor.name(),
+                times.len()
+            );
+            rows.push(json!({"case": format!("speed/{}", sensor.name()), "method": name,
+                "metric": "time_per_frame", "value": median, "unit": "ms", "max_ms": max,
+                "resolution_deg": 45, "frames": times.len()}));
+        }
+    }
+    Ok(table)
 }

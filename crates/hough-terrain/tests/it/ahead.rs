@@ -74,7 +74,7 @@ fn the_thesis_method_stays_algorithm_3() {
 
 #[test]
 fn methods_parse_by_name() {
-    for m in Method::all() {
+    for m in Method::ALL {
         assert_eq!(m.name().parse::<Method>().unwrap(), m);
     }
     assert!(matches!("algorithm-4".parse::<Method>(), Err(HoughError::UnknownName { .. })));
@@ -94,10 +94,8 @@ fn absurd_parameters_are_errors() {
     ] {
         let mut scratch = Default::default();
         assert!(classify_ahead(&floor, 0.45, &limits, &bad, &mut scratch).is_err(), "{bad:?}");
-        let config = HoughConfig {
-            method: Method::GroundAhead(bad),
-            ..HoughConfig::thesis(deg(45.0), mount()).unwrap()
-        };
+        let config =
+            HoughConfig { ahead: bad, ..HoughConfig::recommended(deg(45.0), mount()).unwrap() };
         assert!(HoughClassifier::new(config).is_err());
     }
 }

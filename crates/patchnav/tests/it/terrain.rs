@@ -198,3 +198,26 @@ fn semantickitti_ground_f1() {
     let f1 = 2.0 * tp / (2.0 * tp + fp + fn_);
     assert!(f1 >= 0.97, "F1 {f1}");
 }
+
+#[test]
+fn the_thesis_method_is_a_flag_away() {
+    // A wall 3 m ahead: Algorithm 3 lets the floor in front outvote it; the ground-ahead rule
+    // (the default) sees it standing.
+    let dir = tempfile::tempdir().unwrap();
+    let wall = frame(dir.path(), "wall3.ply", TerrainSpec::Wall { distance: 3.0, height: 2.0 });
+    let run = |extra: &[&str]| {
+        let mut args = vec!["terrain", wall.to_str().unwrap(), "--sensor-height", "0.45"];
+        args.extend_from_slice(extra);
+        let o = patchnav(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let ahead = run(&[]);
+    assert_eq!(line(&ahead, "drivable:"), "drivable:  no", "{ahead}");
+    assert_eq!(line(&ahead, "rule:"), "rule:      AheadObstacle", "{ahead}");
+    let thesis = run(&["--method", "thesis", "--resolution", "45"]);
+    assert_eq!(line(&thesis, "class:"), "class:     floor", "{thesis}");
+    assert_eq!(line(&thesis, "drivable:"), "drivable:  yes", "{thesis}");
+    let o = patchnav(&["terrain", wall.to_str().unwrap(), "--method", "nope"]);
+    assert!(!o.status.success() && stderr(&o).contains("ground-ahead"), "{}", stderr(&o));
+}
