@@ -677,7 +677,9 @@ fn section_terrain(t: Option<&TerrainSection>) -> String {
     let ours = t.map_or(String::new(), |t| {
         let verdict = if t.class == t.truth { "matching" } else { "not matching" };
         format!(
-            " Here the {} snapshot ({} points) is classified as {}, {verdict} the truth ({}), in {} ms.",
+            " Here the {} snapshot ({} points) is classified by the ground-ahead rule (what stands on \
+             the ground, the surface ahead, where the ground drops away; Algorithm 3 stays available \
+             as `--method thesis`) as {}, {verdict} the truth ({}), in {} ms.",
             t.scene,
             int(t.points as u64),
             t.class,

@@ -94,7 +94,8 @@ fn truth_name(c: HoughClass) -> String {
 }
 
 /// Simulates the SR-3000 on a robot at the origin looking along +x at the terrain scene,
-/// classifies the frame at 15° and per left/centre/right sector, and writes the frame
+/// classifies the frame by the ground-ahead rule (Hough space at 15°) and per left/centre/right
+/// sector by Algorithm 3, and writes the frame
 /// (`terrain-frame.ply`) and its Hough space (`terrain-hough.png`, Fig 4.3 layout).
 pub fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
     let spec = terrain_spec();
@@ -104,7 +105,10 @@ pub fn terrain(seed: u64, files: &mut Files) -> Result<TerrainSection> {
     let body = SensorPose::from_position_rpy(Point3::new(0.0, 0.0, TERRAIN_HEIGHT), 0.0, 0.0, 0.0);
     let cloud = camera.scan(&scene, &camera.mount(&body), seed).to_cloud()?;
     let mount = SensorMount::looking_ahead(TERRAIN_HEIGHT, 0.0, 0.0, SensorAxes::Optical)?;
-    let config = HoughConfig::thesis(TERRAIN_RESOLUTION_DEG.to_radians(), mount)?;
+    // The recommended method decides; the Hough space is filled for its picture, and the
+    // sectors are Algorithm 3's.
+    let mut config = HoughConfig::recommended(TERRAIN_RESOLUTION_DEG.to_radians(), mount)?;
+    config.ahead.hough = true;
     let mut classifier = HoughClassifier::new(config)?;
     let t0 = Instant::now();
     let result = classifier.classify_cloud(&cloud)?;
