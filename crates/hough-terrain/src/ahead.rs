@@ -29,7 +29,7 @@
 //!    the thesis's evaluation labels curbs, §4.4.1); else floor.
 
 use crate::ball::{BallPlane, refine_plane};
-use crate::classify::{Classification, RobotLimits, Rule, TerrainClass};
+use crate::classify::{Classification, RobotLimits, Rule, TerrainClass, not_drivable};
 use crate::error::{HoughError, Result};
 use crate::space::Plane;
 use nalgebra::{Point3, Unit, Vector3};
@@ -545,23 +545,7 @@ fn ground_break(
 
 /// A not-drivable obstacle with the floor as its plane and nothing counted.
 fn base(points: usize, height: f64) -> Classification {
-    Classification {
-        class: TerrainClass::Obstacle,
-        passable: false,
-        drivable: false,
-        rule: Rule::AheadObstacle,
-        plane: Some(Plane { rho_x: 0.0, rho_y: 0.0, d: height }),
-        bin: None,
-        votes: 0,
-        max_votes: 0,
-        floor_votes: 0,
-        high_bins: 0,
-        points,
-        step: 0.0,
-        tilt: 0.0,
-        accepted: true,
-        valid_fraction: 1.0,
-    }
+    not_drivable(Rule::AheadObstacle, points, Some(Plane { rho_x: 0.0, rho_y: 0.0, d: height }))
 }
 
 /// Whether a column holds something standing on `ground` higher than the robot's step.

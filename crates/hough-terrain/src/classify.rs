@@ -337,12 +337,17 @@ pub fn algorithm3(
 
 /// The result for a frame the preprocessing test rejected.
 pub(crate) fn rejected(points: usize, valid_fraction: f64) -> Classification {
+    Classification { accepted: false, valid_fraction, ..not_drivable(Rule::Rejected, points, None) }
+}
+
+/// A not-drivable obstacle decided by `rule`, with nothing counted.
+pub(crate) fn not_drivable(rule: Rule, points: usize, plane: Option<Plane>) -> Classification {
     Classification {
         class: TerrainClass::Obstacle,
         passable: false,
         drivable: false,
-        rule: Rule::Rejected,
-        plane: None,
+        rule,
+        plane,
         bin: None,
         votes: 0,
         max_votes: 0,
@@ -351,7 +356,7 @@ pub(crate) fn rejected(points: usize, valid_fraction: f64) -> Classification {
         points,
         step: 0.0,
         tilt: 0.0,
-        accepted: false,
-        valid_fraction,
+        accepted: true,
+        valid_fraction: 1.0,
     }
 }

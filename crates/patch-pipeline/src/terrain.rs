@@ -143,21 +143,12 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
     let cloud = input::read_cloud(&args.frame, &args.input)?;
     ensure!(!cloud.is_empty(), "{}: the frame has no points", args.frame.display());
     let organised = cloud.grid().is_some();
-    let axes = args.axes.unwrap_or(if organised { AxesChoice::Camera } else { AxesChoice::Lidar });
-    let sensor_axes = match axes {
-        AxesChoice::Lidar => SensorAxes::Body,
-        AxesChoice::Camera => SensorAxes::Optical,
-    };
+    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(&cloud));
+    let sensor_axes = axes.sensor_axes();
     let (height, pitch, roll, estimated) = match args.sensor_height {
         Some(h) => (h, args.pitch.unwrap_or(0.0).to_radians(), 0.0, None),
         None => {
-            let e = estimate_mount(cloud.positions(), &MountSearch::new(sensor_axes))
-                .with_context(|| {
-                    format!(
-                        "{}: estimating the sensor's mount (give --sensor-height and --pitch)",
-                        args.frame.display()
-                    )
-                })?;
+            let e = frame_mount(&cloud, sensor_axes, &args.frame)?;
             (e.height, args.pitch.map_or(e.pitch, f64::to_radians), e.roll, Some(e))
         }
     };
@@ -220,6 +211,36 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         seconds,
         classifier,
         sectors,
+    })
+}
+
+impl AxesChoice {
+    /// The default for a cloud: camera axes for an organised frame, lidar axes otherwise.
+    pub fn default_for(cloud: &pointcloud::PointCloud) -> AxesChoice {
+        if cloud.grid().is_some() { AxesChoice::Camera } else { AxesChoice::Lidar }
+    }
+
+    /// The classifier's axes.
+    pub fn sensor_axes(self) -> SensorAxes {
+        match self {
+            AxesChoice::Lidar => SensorAxes::Body,
+            AxesChoice::Camera => SensorAxes::Optical,
+        }
+    }
+}
+
+/// The sensor's mount estimated from the frame's ground plane ([`estimate_mount`]); the error
+/// names the file and how to give the mount instead.
+pub(crate) fn frame_mount(
+    cloud: &pointcloud::PointCloud,
+    axes: SensorAxes,
+    frame: &std::path::Path,
+) -> Result<MountEstimate> {
+    estimate_mount(cloud.positions(), &MountSearch::new(axes)).with_context(|| {
+        format!(
+            "{}: estimating the sensor's mount (give --sensor-height and --pitch)",
+            frame.display()
+        )
     })
 }
 

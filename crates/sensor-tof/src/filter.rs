@@ -373,6 +373,31 @@ impl RayTables {
     }
 }
 
+/// Fails with [`TofError::Mismatch`] unless `frame` has the size of `camera` and range `kind`
+/// that `what` (a filter, an unwrapper) was prepared for.
+pub(crate) fn check_prepared(
+    frame: &TofFrame,
+    camera: &TofCamera,
+    kind: RangeKind,
+    what: &str,
+) -> Result<(), TofError> {
+    let c = frame.camera();
+    if (c.width, c.height) != (camera.width, camera.height) || frame.kind() != kind {
+        return Err(TofError::Mismatch {
+            why: format!(
+                "frame {} × {} {:?}, {what} prepared for {} × {} {:?}",
+                c.width,
+                c.height,
+                frame.kind(),
+                camera.width,
+                camera.height,
+                kind
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// A filter prepared for one camera and range kind: per-pixel limits and ray tables computed
 /// once, then [`TofFilter::apply`] per frame.
 #[derive(Clone, Debug)]
@@ -488,22 +513,7 @@ impl TofFilter {
     /// Filters `frame` into `out` (buffers reused). Fails if the frame is of another camera
     /// size or range kind than the filter was prepared for.
     pub fn apply(&self, frame: &TofFrame, out: &mut FilterOutput) -> Result<(), TofError> {
-        let c = frame.camera();
-        if (c.width, c.height) != (self.camera.width, self.camera.height)
-            || frame.kind() != self.kind
-        {
-            return Err(TofError::Mismatch {
-                why: format!(
-                    "frame {} × {} {:?}, filter prepared for {} × {} {:?}",
-                    c.width,
-                    c.height,
-                    frame.kind(),
-                    self.camera.width,
-                    self.camera.height,
-                    self.kind
-                ),
-            });
-        }
+        check_prepared(frame, &self.camera, self.kind, "filter")?;
         let n = self.camera.num_pixels();
         out.reset(n);
         // No unwrapping: no flagged pixel passes `a > +∞`; unwrapping without a low AT: all do.

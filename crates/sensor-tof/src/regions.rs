@@ -544,22 +544,8 @@ impl RegionUnwrapper {
     /// # Errors
     /// A frame of another size or range kind than prepared for.
     pub fn apply(&self, frame: &TofFrame, out: &mut FilterOutput) -> Result<RegionStats, TofError> {
+        crate::filter::check_prepared(frame, &self.camera, self.kind, "region unwrapper")?;
         let c = frame.camera();
-        if (c.width, c.height) != (self.camera.width, self.camera.height)
-            || frame.kind() != self.kind
-        {
-            return Err(TofError::Mismatch {
-                why: format!(
-                    "frame {} × {} {:?}, region unwrapper prepared for {} × {} {:?}",
-                    c.width,
-                    c.height,
-                    frame.kind(),
-                    self.camera.width,
-                    self.camera.height,
-                    self.kind
-                ),
-            });
-        }
         let (w, h) = (c.width as usize, c.height as usize);
         let n = w * h;
         out.reset(n);

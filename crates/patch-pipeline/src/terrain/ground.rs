@@ -9,10 +9,7 @@
 use super::AxesChoice;
 use crate::input::{self, CloudInput};
 use anyhow::{Context, Result, ensure};
-use hough_terrain::{
-    GroundSegmenter, GroundSettings, GroundSummary, MountEstimate, MountSearch, SensorAxes,
-    SensorMount, estimate_mount,
-};
+use hough_terrain::{GroundSegmenter, GroundSettings, GroundSummary, MountEstimate, SensorMount};
 use pointcloud::{FieldData, PointCloud, ScalarField};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -30,7 +27,7 @@ pub struct GroundSetup {
     /// The sensor's axes (`None`: camera for organised frames, lidar otherwise).
     pub axes: Option<AxesChoice>,
     /// The mount: height (m), pitch (degrees down) and roll (degrees); `None`: estimated from
-    /// the frame ([`estimate_mount`]).
+    /// the frame ([`hough_terrain::estimate_mount`]).
     pub mount: Option<(f64, f64, f64)>,
     /// Where to write the labelled cloud (any cloud format that keeps extra fields: PLY, PCD).
     pub out: Option<PathBuf>,
@@ -105,15 +102,8 @@ pub fn segment_ground(args: &GroundSetup) -> Result<Grounded> {
     ensure!((1..=100_000).contains(&args.repeat), "--repeat must be in 1..=100000");
     let cloud = input::read_cloud(&args.frame, &args.input)?;
     ensure!(!cloud.is_empty(), "{}: the frame has no points", args.frame.display());
-    let axes = args.axes.unwrap_or(if cloud.grid().is_some() {
-        AxesChoice::Camera
-    } else {
-        AxesChoice::Lidar
-    });
-    let sensor_axes = match axes {
-        AxesChoice::Lidar => SensorAxes::Body,
-        AxesChoice::Camera => SensorAxes::Optical,
-    };
+    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(&cloud));
+    let sensor_axes = axes.sensor_axes();
     let (height, pitch, roll, estimated) = match args.mount {
         Some((h, p, r)) => {
             ensure!(h.is_finite() && h.abs() <= 100.0, "--sensor-height must be finite, not {h}");
@@ -121,13 +111,7 @@ pub fn segment_ground(args: &GroundSetup) -> Result<Grounded> {
             (h, p.to_radians(), r.to_radians(), None)
         }
         None => {
-            let e = estimate_mount(cloud.positions(), &MountSearch::new(sensor_axes))
-                .with_context(|| {
-                    format!(
-                        "{}: estimating the sensor's mount (give --sensor-height and --pitch)",
-                        args.frame.display()
-                    )
-                })?;
+            let e = super::frame_mount(&cloud, sensor_axes, &args.frame)?;
             (e.height, e.pitch, e.roll, Some(e))
         }
     };
