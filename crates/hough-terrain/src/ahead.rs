@@ -8,25 +8,36 @@
 //! metres ahead and `half_width` metres to either side:
 //!
 //! 1. Heights are measured above the floor the mount gives (`h − z`, z down). Points within
-//!    `floor_band` of it are *floor*; the rest are *off-floor*.
-//! 2. A sampled plane fit (RANSAC, `iterations` tries on at most `sample` off-floor points,
-//!    refined by least squares) finds the dominant plane among the off-floor points. It is the
-//!    *surface* ahead if it holds at least `surface_share` of them, spreads at least
-//!    `surface_width` across, is at most `steep_tilt` from level, and does not float: fewer than
-//!    `max_floating` of the grid cells it covers also show floor below it (a sheet of
-//!    wrapped-around time-of-flight pixels hovers over visible floor; a real plateau hides the
-//!    floor behind its edge).
-//! 3. Every `cell` × `cell` column of the corridor is checked for something standing on the
-//!    ground: its points are binned by height (`bin` metres, a bin counts with `min_bin_points`
-//!    points); from the ground bin (the floor's, or the surface's where the surface lies) the
-//!    occupied bins are followed upwards across gaps of at most `max_gap` metres. A column that
-//!    rises more than `max_step` above the ground is an obstacle cell. Points that float (no
-//!    occupied bin joins them to the ground) do not count: wrapped-around and noise points
-//!    hover, objects stand.
-//! 4. The class: obstacle with at least `obstacle_cells` obstacle cells, or with too few points
-//!    ahead (`min_points`); else the surface's class (a level surface above the floor is a
-//!    plateau, below it a canyon, a tilted one a ramp; a step the robot can take is floor, as
-//!    the thesis's evaluation labels curbs, §4.4.1); else floor.
+//!    `floor_band` of it are *floor*; the rest are *off-floor*. Fewer than `min_points` points
+//!    ahead is an obstacle (nothing seen is not free).
+//! 2. A sampled plane fit (RANSAC, `iterations` tries of ground-like planes, at most
+//!    `steep_tilt` from level, on at most `sample` off-floor points, refined by least squares)
+//!    finds the dominant ground plane among the off-floor points. It is the *surface* ahead if
+//!    it holds at least `surface_share` of them and spreads at least `surface_width` across; if
+//!    it does not float (at most `max_floating` of the cells it covers show more floor below it
+//!    than surface: a sheet of wrapped-around time-of-flight pixels hovers over visible floor, a
+//!    real plateau hides the floor behind its edge); and if it shows in at least `min_coverage`
+//!    of the occupied cells of its extent (the tops of scattered objects are no surface).
+//! 3. Every `cell` × `cell` column is checked for something standing on the ground: its points
+//!    are binned by height (`bin` metres). A bin counts if it holds `min_column_fraction` of what
+//!    a vertical surface at that distance shows this sensor (`pixel_pitch`), and at least
+//!    `min_bin_points`: range noise scatters points thinly along the beams, surfaces do not.
+//!    From the ground (the floor's height, or the surface's where the surface lies) the
+//!    occupied bins are followed upwards across gaps of at most `max_gap`; a column rising more
+//!    than the robot's `max_step` above the ground is an obstacle cell. Points that float (no
+//!    occupied bin joins them to the ground) do not count. `obstacle_cells` obstacle cells make
+//!    the frame an obstacle.
+//! 4. In the strip `strip_half_width` to either side straight ahead, the rows that show ground
+//!    (floor or surface, at `min_ground_fraction` of the density the floor would show there)
+//!    are followed outwards. At a break of at least `min_drop_gap` with points beyond, the
+//!    `drop_quantile` of those points' heights is the ground beyond (range noise drags points
+//!    along their beams towards the sensor, that is up); deeper than the step is a *canyon*.
+//! 5. Otherwise the surface decides: a level one (within `level_tilt`) is a plateau above the
+//!    floor or a canyon below it, passable up to `max_step + step_allowance`; a step the robot
+//!    can take is *floor*, as the thesis's evaluation labels curbs (§4.4.1); a tilted one is a
+//!    ramp, passable up to `max_slope`. Without a surface the frame is floor.
+//!
+//! docs/terrain.md has the rule's figures beside Algorithm 3's on the simulated snapshots.
 
 use crate::ball::{BallPlane, refine_plane};
 use crate::classify::{Classification, RobotLimits, Rule, TerrainClass, not_drivable};
