@@ -669,7 +669,7 @@ fn find_surface(
     // Floating: the floor shows in the cells it covers (more of it than of the surface), where
     // it lies clearly off the floor.
     // Patchy: within its extent, the cells that show points show it.
-    let (mut covered, mut over_floor, mut occupied) = (0usize, 0usize, 0usize);
+    let (mut covered, mut over_floor, mut occupied, mut shown) = (0usize, 0usize, 0usize, 0usize);
     for (c, (&on_surface, &on_floor)) in
         scratch.surface_cells.iter().zip(&scratch.floor_cells).enumerate()
     {
@@ -678,13 +678,17 @@ fn find_surface(
             ((c / nx) as f64 + 0.5) * rule.cell - rule.half_width,
         );
         let inside = (x_min..=x_max).contains(&x) && (y_min..=y_max).contains(&y);
-        if inside && scratch.cell_points[c] >= SHOWS {
+        let has_points = scratch.cell_points[c] >= SHOWS;
+        if inside && has_points {
             occupied += 1;
         }
         if on_surface < SHOWS {
             continue;
         }
         covered += 1;
+        if inside && has_points {
+            shown += 1;
+        }
         let apart = surface.height_at(x, y).is_some_and(|h| h.abs() > 2.0 * rule.floor_band);
         if apart && on_floor >= SHOWS.max(on_surface) {
             over_floor += 1;
@@ -694,8 +698,8 @@ fn find_surface(
         scratch.facts.floating_surface = true;
         return None;
     }
-    scratch.facts.surface_coverage = covered as f64 / occupied.max(1) as f64;
-    if (covered as f64) < rule.min_coverage * occupied as f64 {
+    scratch.facts.surface_coverage = shown as f64 / occupied.max(1) as f64;
+    if (shown as f64) < rule.min_coverage * occupied as f64 {
         return None;
     }
     Some(surface)
