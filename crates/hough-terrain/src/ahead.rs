@@ -251,6 +251,11 @@ impl GroundAhead {
         (self.lookahead / self.cell).ceil() as usize
     }
 
+    /// The centre (x ahead, y left) of cell `c` of a grid `nx` cells long.
+    fn cell_centre(&self, c: usize, nx: usize) -> (f64, f64) {
+        (((c % nx) as f64 + 0.5) * self.cell, ((c / nx) as f64 + 0.5) * self.cell - self.half_width)
+    }
+
     fn ny(&self) -> usize {
         (2.0 * self.half_width / self.cell).ceil() as usize
     }
@@ -373,15 +378,24 @@ pub fn classify_ahead(
         let iy = (((p.y + rule.half_width) / rule.cell).max(0.0) as usize).min(ny - 1);
         iy * nx + ix
     };
+    // One pass: points and floor points per cell, and the columns' height-bin counts.
     scratch.floor_cells.clear();
     scratch.floor_cells.resize(nx * ny, 0);
     scratch.cell_points.clear();
     scratch.cell_points.resize(nx * ny, 0);
+    scratch.counts.clear();
+    scratch.counts.resize(nx * ny * BINS, 0);
+    let h0 = rule.min_height();
     for p in &scratch.ahead {
         let c = cell_of(p);
         scratch.cell_points[c] = scratch.cell_points[c].saturating_add(1);
         if p.z.abs() <= rule.floor_band {
             scratch.floor_cells[c] = scratch.floor_cells[c].saturating_add(1);
+        }
+        let b = ((p.z - h0) / rule.bin).floor();
+        if b >= 0.0 && b < BINS as f64 {
+            let i = c * BINS + b as usize;
+            scratch.counts[i] = scratch.counts[i].saturating_add(1);
         }
     }
 
@@ -389,26 +403,13 @@ pub fn classify_ahead(
     if let Some(s) = &surface {
         scratch.facts.surface_points = s.points;
     }
-
-    // Columns: height-bin counts per cell.
-    scratch.counts.clear();
-    scratch.counts.resize(nx * ny * BINS, 0);
-    let h0 = rule.min_height();
-    for p in &scratch.ahead {
-        let b = ((p.z - h0) / rule.bin).floor();
-        if b >= 0.0 && b < BINS as f64 {
-            let i = cell_of(p) * BINS + b as usize;
-            scratch.counts[i] = scratch.counts[i].saturating_add(1);
-        }
-    }
     let gap_bins = (rule.max_gap / rule.bin).floor() as usize;
     let mut obstacle_cells = 0;
     for iy in 0..ny {
         for ix in 0..nx {
             let c = iy * nx + ix;
             let column = &scratch.counts[c * BINS..(c + 1) * BINS];
-            let (x, y) =
-                ((ix as f64 + 0.5) * rule.cell, (iy as f64 + 0.5) * rule.cell - rule.half_width);
+            let (x, y) = rule.cell_centre(c, nx);
             let x_lo = ix as f64 * rule.cell;
             let ground = surface
                 .and_then(|s| {
@@ -673,10 +674,7 @@ fn find_surface(
     for (c, (&on_surface, &on_floor)) in
         scratch.surface_cells.iter().zip(&scratch.floor_cells).enumerate()
     {
-        let (x, y) = (
-            ((c % nx) as f64 + 0.5) * rule.cell,
-            ((c / nx) as f64 + 0.5) * rule.cell - rule.half_width,
-        );
+        let (x, y) = rule.cell_centre(c, nx);
         let inside = (x_min..=x_max).contains(&x) && (y_min..=y_max).contains(&y);
         let has_points = scratch.cell_points[c] >= SHOWS;
         if inside && has_points {

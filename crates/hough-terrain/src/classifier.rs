@@ -203,17 +203,16 @@ impl HoughClassifier {
         if !self.config.classifier.preprocessing.accepts(valid, frame_pixels) {
             return Ok(rejected(valid, fraction));
         }
+        // The ground-ahead rule alone leaves the Hough space empty.
         let vote = self.config.method == Method::Thesis || self.config.ahead.hough;
-        if !vote {
-            // The ground-ahead rule alone: the Hough space stays empty.
-        } else if self.config.threads > 1 {
+        if vote && self.config.threads > 1 {
             self.table.vote_parallel(
                 &self.levelled,
                 &mut self.acc,
                 &mut self.partials,
                 self.config.threads,
             )?;
-        } else {
+        } else if vote {
             self.table.vote(&self.levelled, &mut self.acc)?;
         }
         let mut c = match self.config.method {
