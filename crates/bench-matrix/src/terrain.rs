@@ -61,6 +61,12 @@ pub fn run(seed: u64) -> Result<Vec<Value>> {
             &thesis::TABLE_4_7[..],
             thesis::TABLE_4_7_MEAN,
         ),
+        (
+            Sensor::TofSunMasked,
+            "Table 4.7 (time of flight, sunlit, saturated pixels left out)",
+            &thesis::TABLE_4_7[..],
+            thesis::TABLE_4_7_MEAN,
+        ),
     ] {
         for method in METHODS {
             eprintln!(

@@ -171,7 +171,8 @@ impl HoughClassifier {
             + self.ahead.capacity_bytes()
     }
 
-    /// What the ground-ahead rule saw in the last frame (all zero under [`Method::Thesis`]).
+    /// What the ground-ahead rule saw in the last frame (all zero under [`Method::Thesis`] and
+    /// for a frame the preprocessing rejected).
     pub fn ahead_facts(&self) -> crate::ahead::AheadFacts {
         self.ahead.facts
     }
@@ -196,6 +197,7 @@ impl HoughClassifier {
         points: &[Point3<f64>],
         frame_pixels: usize,
     ) -> Result<Classification> {
+        self.ahead.facts = crate::ahead::AheadFacts::default();
         self.level(points, frame_pixels)?;
         self.acc.clear();
         let valid = self.levelled.len();

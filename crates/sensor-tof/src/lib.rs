@@ -12,6 +12,7 @@
 //! | two-frequency unwrapping | [`two_freq`] | beyond the thesis |
 //! | spatial consistency of the flags | [`spatial`] | beyond the thesis |
 //! | region unwrapping: unwrap only where a smooth region agrees | [`regions`] | beyond the thesis |
+//! | saturated pixels, from the intensity image | [`saturation`] | beyond the thesis (L2009–2017) |
 //! | simulator on `scene-sim`'s range camera | [`sim`] | §2.5.4 error types, Table 2.3 |
 //! | the six test scenes of Table 2.4 | [`scenes`] | §2.5.6 |
 //! | scoring against the truth | [`eval`] | Table 2.4 (+ our metrics) |
@@ -31,6 +32,7 @@ pub mod filter;
 pub mod frame;
 pub mod io;
 pub mod regions;
+pub mod saturation;
 pub mod scenes;
 pub mod sim;
 pub mod spatial;
@@ -49,6 +51,7 @@ pub use filter::{
 pub use frame::TofFrame;
 pub use io::FrameMeta;
 pub use regions::{RegionConfig, RegionUnwrapper, ScatterGate};
+pub use saturation::Saturation;
 pub use sim::{SimConfig, SimulatedFrame, TofSimulator};
 pub use spatial::SpatialConfig;
 pub use two_freq::{TwoFreqConfig, TwoFreqUnwrapper};

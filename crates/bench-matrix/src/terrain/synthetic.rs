@@ -11,6 +11,7 @@ use anyhow::{Context, Result};
 use hough_terrain::{HoughClassifier, HoughConfig, Method, SensorAxes, SensorMount, TerrainClass};
 use nalgebra::Point3;
 use scene_sim::{HoughClass, RangeSensor, Scene, SceneBuilder, StereoCamera, TerrainSpec, terrain};
+use sensor_tof::Saturation;
 use sensor_tof::sim::{SimConfig, SunRegion, TofSimulator};
 use std::time::Instant;
 
@@ -30,19 +31,24 @@ pub(crate) enum Sensor {
     Tof,
     /// SR-3000 simulator with sunlight on the whole scene.
     TofSun,
+    /// [`Sensor::TofSun`]'s frames with the saturated pixels left out
+    /// ([`sensor_tof::Saturation`]), as a camera that flags saturation gives them.
+    TofSunMasked,
     /// STOC stereo camera.
     Stereo,
 }
 
 impl Sensor {
     /// Every simulated sensor, in table order.
-    pub(crate) const ALL: [Sensor; 3] = [Sensor::Tof, Sensor::TofSun, Sensor::Stereo];
+    pub(crate) const ALL: [Sensor; 4] =
+        [Sensor::Tof, Sensor::TofSun, Sensor::TofSunMasked, Sensor::Stereo];
 
     /// The short name used in tables and JSON rows.
     pub(crate) fn name(self) -> &'static str {
         match self {
             Sensor::Tof => "tof",
             Sensor::TofSun => "tof-sun",
+            Sensor::TofSunMasked => "tof-sun-masked",
             Sensor::Stereo => "stereo",
         }
     }
@@ -200,6 +206,8 @@ pub(crate) fn mount() -> Result<SensorMount> {
 pub(crate) struct FrameMaker {
     sensor: Sensor,
     tof: Option<TofSimulator>,
+    /// The saturation test whose pixels are left out ([`Sensor::TofSunMasked`]).
+    saturation: Option<Saturation>,
     stereo: StereoCamera,
 }
 
@@ -208,9 +216,9 @@ impl FrameMaker {
     pub(crate) fn new(sensor: Sensor) -> Result<FrameMaker> {
         let tof = match sensor {
             Sensor::Stereo => None,
-            Sensor::Tof | Sensor::TofSun => {
+            Sensor::Tof | Sensor::TofSun | Sensor::TofSunMasked => {
                 let mut cfg = SimConfig::sr3000();
-                if sensor == Sensor::TofSun {
+                if sensor != Sensor::Tof {
                     cfg.sun = vec![SunRegion {
                         min: Point3::new(-4.0, -7.0, -6.0),
                         max: Point3::new(13.0, 7.0, 6.0),
@@ -220,7 +228,8 @@ impl FrameMaker {
                 Some(TofSimulator::new(cfg)?)
             }
         };
-        Ok(FrameMaker { sensor, tof, stereo: StereoCamera::stoc() })
+        let saturation = (sensor == Sensor::TofSunMasked).then(Saturation::sr3000);
+        Ok(FrameMaker { sensor, tof, saturation, stereo: StereoCamera::stoc() })
     }
 
     /// One frame of `scene`: the valid points (optical frame) into `points`; returns the pixel
@@ -248,9 +257,13 @@ impl FrameMaker {
                 let pose = scene_sim::RangeCamera::swissranger_sr3000().mount(body);
                 let sim_frame = sim.simulate(scene, &pose, seed)?;
                 let frame = &sim_frame.frame;
+                let saturated = match self.saturation {
+                    Some(s) => s.mask(frame)?,
+                    None => Vec::new(),
+                };
                 for (i, truth) in sim_frame.truth.radial.iter().enumerate() {
                     let range = frame.range()[i];
-                    if truth.is_some() && range > 0.0 {
+                    if truth.is_some() && range > 0.0 && !saturated.get(i).is_some_and(|s| *s) {
                         let (col, row) = frame.col_row(i);
                         points.push(frame.camera().point(col, row, f64::from(range), frame.kind()));
                     }

@@ -3,6 +3,7 @@
 mod calibrate;
 mod experiment;
 mod io;
+mod saturation;
 mod scenes;
 mod sim;
 mod spatial;
