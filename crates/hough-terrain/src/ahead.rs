@@ -26,7 +26,12 @@
 //!    occupied bins are followed upwards across gaps of at most `max_gap`; a column rising more
 //!    than the robot's `max_step` above the ground is an obstacle cell. Points that float (no
 //!    occupied bin joins them to the ground) do not count. `obstacle_cells` obstacle cells make
-//!    the frame an obstacle.
+//!    the frame an obstacle, unless they form a *ledge*: in at least `ledge_share` of the
+//!    lateral rows that show points (up to the farthest such column; range noise scatters
+//!    points beyond and out to the side), the nearest obstacle cell's top agrees within
+//!    `ledge_spread` and lies at most `ledge_rise` above the sensor. That is a plateau too high
+//!    to climb whose face spans the view (its top may be out of sight); a wall's columns end at
+//!    the view's upper edge instead. Either way the frame is not drivable.
 //! 4. In the strip `strip_half_width` to either side straight ahead, the rows that show ground
 //!    (floor or surface, at `min_ground_fraction` of the density the floor would show there)
 //!    are followed outwards. At a break of at least `min_drop_gap` with points beyond, the
@@ -98,13 +103,18 @@ pub struct GroundAhead {
     /// occupied: `cell · bin / (pixel_pitch · x)²` at `x` metres (range noise scatters far
     /// fewer). 0.1.
     pub min_column_fraction: f64,
-    /// Share of the points the floor would show (`2 · strip_half_width · cell · h /
-    /// (pixel_pitch² · x³)` for a sensor `h` metres up) that a row of the strip ahead needs to
-    /// count as ground. 0.25.
     /// Largest empty gap a column may have and still stand. 0.1 m.
     pub max_gap: f64,
-    /// Obstacle cells that make the frame an obstacle. 2.
+    /// Obstacle cells that make the frame an obstacle (or a ledge). 2.
     pub obstacle_cells: usize,
+    /// Least share of the lateral rows that show points in which the nearest standing column
+    /// must belong to a ledge: a face across the view with a level top edge. 0.3.
+    pub ledge_share: f64,
+    /// How far above the sensor a ledge's top edge may lie (higher, it is the view's edge on a
+    /// wall). 0.15 m.
+    pub ledge_rise: f64,
+    /// Largest spread of the ledge's top edge (its 10th to 90th percentile). 0.15 m.
+    pub ledge_spread: f64,
     /// What a measured step may exceed the robot's `max_step` by and still pass: the range
     /// noise's share of the fit (the thesis's steps are rounded to its 0.1 m d bins). 0.05 m.
     pub step_allowance: f64,
@@ -114,7 +124,9 @@ pub struct GroundAhead {
     pub min_drop_gap: f64,
     /// Which height quantile of the points beyond a break is the ground there. 0.25.
     pub drop_quantile: f64,
-    /// See `min_column_fraction`.
+    /// Share of the points the floor would show (`2 · strip_half_width · cell · h /
+    /// (pixel_pitch² · x³)` for a sensor `h` metres up) that a row of the strip ahead needs to
+    /// count as ground. 0.25.
     pub min_ground_fraction: f64,
     /// Seed of the sampled fit (the result is deterministic for a frame).
     pub seed: u64,
@@ -148,6 +160,9 @@ impl GroundAhead {
             min_ground_fraction: 0.25,
             max_gap: 0.1,
             obstacle_cells: 2,
+            ledge_share: 0.3,
+            ledge_rise: 0.15,
+            ledge_spread: 0.15,
             step_allowance: 0.05,
             strip_half_width: 0.6,
             min_drop_gap: 0.4,
@@ -195,6 +210,15 @@ impl GroundAhead {
                 allowed: "[0.0006°, 28°]",
             });
         }
+        for (what, v) in [("ledge_rise", self.ledge_rise), ("ledge_spread", self.ledge_spread)] {
+            if !(-1e3..=1e3).contains(&v) {
+                return Err(HoughError::BadParameter {
+                    what,
+                    value: v,
+                    allowed: "[-1000, 1000] m",
+                });
+            }
+        }
         if !(self.max_gap.is_finite() && self.max_gap >= 0.0) {
             return Err(HoughError::BadParameter {
                 what: "max_gap",
@@ -209,9 +233,15 @@ impl GroundAhead {
                 allowed: "[0, 1000] m",
             });
         }
-        for (what, v) in
-            [("surface_share", self.surface_share), ("max_floating", self.max_floating)]
-        {
+        for (what, v) in [
+            ("surface_share", self.surface_share),
+            ("max_floating", self.max_floating),
+            ("min_coverage", self.min_coverage),
+            ("min_column_fraction", self.min_column_fraction),
+            ("min_ground_fraction", self.min_ground_fraction),
+            ("drop_quantile", self.drop_quantile),
+            ("ledge_share", self.ledge_share),
+        ] {
             if !(0.0..=1.0).contains(&v) {
                 return Err(HoughError::BadParameter { what, value: v, allowed: "[0, 1]" });
             }
@@ -282,6 +312,13 @@ pub struct AheadFacts {
     pub ground_gap: f64,
     /// How far below the floor the ground beyond that break lies, metres.
     pub drop_depth: f64,
+    /// The share of the lateral rows showing points whose nearest column stands (0 without
+    /// obstacle cells).
+    pub front_share: f64,
+    /// The median top of those columns above the floor, metres.
+    pub front_top: f64,
+    /// The spread of their tops (10th to 90th percentile), metres.
+    pub front_spread: f64,
 }
 
 /// Reused buffers of the ground-ahead rule: no allocation per frame once grown.
@@ -292,6 +329,8 @@ pub struct AheadScratch {
     off: Vec<Point3<f64>>,
     sample: Vec<Point3<f64>>,
     counts: Vec<u8>,
+    /// Per lateral row, the nearest standing column: its cell along the heading and its top.
+    front: Vec<Option<(usize, f64)>>,
     floor_cells: Vec<u16>,
     surface_cells: Vec<u16>,
     rows: Vec<u16>,
@@ -307,6 +346,7 @@ impl AheadScratch {
         (self.ahead.capacity() + self.off.capacity() + self.sample.capacity())
             * std::mem::size_of::<Point3<f64>>()
             + self.heights.capacity() * 8
+            + self.front.capacity() * std::mem::size_of::<Option<(usize, f64)>>()
             + self.counts.capacity()
             + (self.floor_cells.capacity()
                 + self.surface_cells.capacity()
@@ -354,14 +394,41 @@ pub fn classify_ahead(
     scratch.facts = AheadFacts::default();
     scratch.ahead.clear();
     scratch.off.clear();
+    let per_cell = rule.cell.recip();
+    let cell_of = |p: &Point3<f64>| -> usize {
+        let ix = ((p.x * per_cell) as usize).min(nx - 1);
+        let iy = (((p.y + rule.half_width) * per_cell).max(0.0) as usize).min(ny - 1);
+        iy * nx + ix
+    };
+    // One pass: the points ahead, those off the floor, the points and floor points per cell,
+    // and the columns' height-bin counts.
+    scratch.floor_cells.clear();
+    scratch.floor_cells.resize(nx * ny, 0);
+    scratch.cell_points.clear();
+    scratch.cell_points.resize(nx * ny, 0);
+    scratch.counts.clear();
+    scratch.counts.resize(nx * ny * BINS, 0);
+    let h0 = rule.min_height();
+    let per_bin = rule.bin.recip();
     for p in levelled {
-        if p.x > 0.0 && p.x <= rule.lookahead && p.y.abs() <= rule.half_width {
-            // z up, y left: the frame of `Plane::to_z_up`.
-            let q = Point3::new(p.x, -p.y, height - p.z);
-            scratch.ahead.push(q);
-            if q.z.abs() > rule.floor_band {
-                scratch.off.push(q);
-            }
+        if !(p.x > 0.0 && p.x <= rule.lookahead && p.y.abs() <= rule.half_width) {
+            continue;
+        }
+        // z up, y left: the frame of `Plane::to_z_up`.
+        let q = Point3::new(p.x, -p.y, height - p.z);
+        scratch.ahead.push(q);
+        let c = cell_of(&q);
+        scratch.cell_points[c] = scratch.cell_points[c].saturating_add(1);
+        if q.z.abs() > rule.floor_band {
+            scratch.off.push(q);
+        } else {
+            scratch.floor_cells[c] = scratch.floor_cells[c].saturating_add(1);
+        }
+        // Truncation is the floor for b ≥ 0 (and `f64::floor` is a libm call here).
+        let b = (q.z - h0) * per_bin;
+        if b >= 0.0 && b < BINS as f64 {
+            let i = c * BINS + b as usize;
+            scratch.counts[i] = scratch.counts[i].saturating_add(1);
         }
     }
     let mut out = base(levelled.len(), height);
@@ -372,39 +439,14 @@ pub fn classify_ahead(
         return Ok(out);
     }
 
-    // Where the floor shows, per cell.
-    let cell_of = |p: &Point3<f64>| -> usize {
-        let ix = ((p.x / rule.cell) as usize).min(nx - 1);
-        let iy = (((p.y + rule.half_width) / rule.cell).max(0.0) as usize).min(ny - 1);
-        iy * nx + ix
-    };
-    // One pass: points and floor points per cell, and the columns' height-bin counts.
-    scratch.floor_cells.clear();
-    scratch.floor_cells.resize(nx * ny, 0);
-    scratch.cell_points.clear();
-    scratch.cell_points.resize(nx * ny, 0);
-    scratch.counts.clear();
-    scratch.counts.resize(nx * ny * BINS, 0);
-    let h0 = rule.min_height();
-    for p in &scratch.ahead {
-        let c = cell_of(p);
-        scratch.cell_points[c] = scratch.cell_points[c].saturating_add(1);
-        if p.z.abs() <= rule.floor_band {
-            scratch.floor_cells[c] = scratch.floor_cells[c].saturating_add(1);
-        }
-        let b = ((p.z - h0) / rule.bin).floor();
-        if b >= 0.0 && b < BINS as f64 {
-            let i = c * BINS + b as usize;
-            scratch.counts[i] = scratch.counts[i].saturating_add(1);
-        }
-    }
-
     let surface = find_surface(rule, scratch, &cell_of, nx);
     if let Some(s) = &surface {
         scratch.facts.surface_points = s.points;
     }
     let gap_bins = (rule.max_gap / rule.bin).floor() as usize;
     let mut obstacle_cells = 0;
+    scratch.front.clear();
+    scratch.front.resize(ny, None);
     for iy in 0..ny {
         for ix in 0..nx {
             let c = iy * nx + ix;
@@ -421,14 +463,22 @@ pub fn classify_ahead(
             let full = rule.cell * rule.bin / (rule.pixel_pitch * x).powi(2);
             let least = (rule.min_column_fraction * full).max(f64::from(rule.min_bin_points));
             let least = least.min(255.0) as u8;
-            if stands(column, ground, least, rule, limits, gap_bins) {
+            if let Some(top) = stands(column, ground, least, rule, limits, gap_bins) {
                 obstacle_cells += 1;
+                // Rows are visited nearest cell first.
+                scratch.front[iy].get_or_insert((ix, top));
             }
         }
     }
     scratch.facts.obstacle_cells = obstacle_cells;
     if obstacle_cells >= rule.obstacle_cells {
         out.rule = Rule::AheadObstacle;
+        if let Some(top) = ledge(rule, height, scratch, nx) {
+            // Higher than a step by construction of the columns: not passable.
+            out.class = TerrainClass::Plateau;
+            out.rule = Rule::AheadLedge;
+            out.step = top;
+        }
         return Ok(out);
     }
     // Does the ground drop away beyond a break in the strip ahead?
@@ -555,6 +605,37 @@ fn ground_break(
     None
 }
 
+/// The height of a ledge ahead, if the nearest standing columns form one: in at least
+/// `ledge_share` of the lateral rows that show points up to the farthest of them, with top edges that agree within
+/// `ledge_spread` and lie at most `ledge_rise` above the sensor (a plateau too high to climb
+/// whose face spans the view; a wall's columns end at the view's upper edge instead).
+fn ledge(rule: &GroundAhead, height: f64, scratch: &mut AheadScratch, nx: usize) -> Option<f64> {
+    // Range noise scatters points along the beams, beyond the face and out to the side: only
+    // cells up to the farthest front count.
+    let reach = scratch.front.iter().flatten().map(|f| f.0).max()?;
+    let rows = scratch
+        .cell_points
+        .chunks(nx)
+        .filter(|row| row[..=reach].iter().any(|&n| n >= SHOWS))
+        .count();
+    let tops = &mut scratch.heights;
+    tops.clear();
+    tops.extend(scratch.front.iter().flatten().map(|f| f.1));
+    if tops.is_empty() {
+        return None;
+    }
+    tops.sort_by(f64::total_cmp);
+    let at = |q: f64| tops[((tops.len() - 1) as f64 * q).round() as usize];
+    let (low, median, high) = (at(0.1), at(0.5), at(0.9));
+    let share = tops.len() as f64 / rows.max(1) as f64;
+    let facts = &mut scratch.facts;
+    (facts.front_share, facts.front_top, facts.front_spread) = (share, median, high - low);
+    (share >= rule.ledge_share
+        && high - low <= rule.ledge_spread
+        && median <= height + rule.ledge_rise)
+        .then_some(median)
+}
+
 /// A not-drivable obstacle with the floor as its plane and nothing counted.
 fn base(points: usize, height: f64) -> Classification {
     not_drivable(Rule::AheadObstacle, points, Some(Plane { rho_x: 0.0, rho_y: 0.0, d: height }))
@@ -568,7 +649,7 @@ fn stands(
     rule: &GroundAhead,
     limits: &RobotLimits,
     gap: usize,
-) -> bool {
+) -> Option<f64> {
     let h0 = rule.min_height();
     let bin_of = |z: f64| ((z - h0) / rule.bin).floor().clamp(0.0, (BINS - 1) as f64) as usize;
     let occupied = |b: usize| column[b] >= least;
@@ -576,7 +657,7 @@ fn stands(
     // ground itself is hidden, at the lowest occupied bin no higher than a step above it.
     let lo = bin_of(ground - rule.floor_band);
     let top_start = bin_of(ground + limits.max_step);
-    let Some(start) = (lo..=top_start).find(|&b| occupied(b)) else { return false };
+    let start = (lo..=top_start).find(|&b| occupied(b))?;
     let mut top = start;
     let mut b = start + 1;
     while b < BINS && b <= top + gap + 1 {
@@ -586,7 +667,7 @@ fn stands(
         b += 1;
     }
     let top_height = h0 + (top + 1) as f64 * rule.bin;
-    top_height > ground + limits.max_step + rule.bin
+    (top_height > ground + limits.max_step + rule.bin).then_some(top_height)
 }
 
 /// The dominant plane among the off-floor points, if it is a surface (see the module docs).

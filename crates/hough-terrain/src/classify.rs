@@ -165,6 +165,9 @@ pub enum Rule {
     AheadSurface,
     /// Ground-ahead rule: something higher than the robot's step stands ahead: obstacle.
     AheadObstacle,
+    /// Ground-ahead rule: a face higher than the robot's step spans the view with a level top
+    /// edge: plateau.
+    AheadLedge,
     /// Ground-ahead rule: too few points ahead to tell: obstacle.
     AheadTooFew,
     /// Ground-ahead rule: the ground ends ahead and what lies beyond is out of a step's reach:

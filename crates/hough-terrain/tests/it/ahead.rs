@@ -29,6 +29,7 @@ fn scenes_get_their_drivability_and_class() {
         (ramp(30.0), Ramp, true),
         (ramp(45.0), Ramp, false),
         (TerrainSpec::Plateau { height: 0.3, distance: 1.5 }, Plateau, false),
+        (TerrainSpec::Plateau { height: 0.5, distance: 1.5 }, Plateau, false),
         (TerrainSpec::Canyon { depth: 0.5, distance: 1.5 }, Canyon, false),
         (TerrainSpec::Canyon { depth: 0.1, distance: 1.5 }, Floor, true),
         (TerrainSpec::Wall { distance: 3.0, height: 2.0 }, Obstacle, false),
@@ -73,6 +74,20 @@ fn the_thesis_method_stays_algorithm_3() {
 }
 
 #[test]
+fn a_face_across_the_view_with_a_level_top_is_a_ledge_and_a_wall_is_not() {
+    // The plateau's top (0.5 m) is out of sight behind its edge; its face spans the view.
+    for seed in 1..=2 {
+        let plateau = sr_frame(&TerrainSpec::Plateau { height: 0.5, distance: 1.5 }, seed);
+        let c = classify(&plateau);
+        assert_eq!((c.rule, c.class, c.drivable), (Rule::AheadLedge, TerrainClass::Plateau, false));
+        assert!((c.step - 0.5).abs() <= 0.05, "step {}", c.step);
+        // A wall's columns end at the view's upper edge, far above the sensor.
+        let wall = sr_frame(&TerrainSpec::Wall { distance: 2.0, height: 2.0 }, seed);
+        assert_eq!(classify(&wall).rule, Rule::AheadObstacle);
+    }
+}
+
+#[test]
 fn methods_parse_by_name() {
     for m in Method::ALL {
         assert_eq!(m.name().parse::<Method>().unwrap(), m);
@@ -91,6 +106,9 @@ fn absurd_parameters_are_errors() {
         GroundAhead { surface_share: 1.5, ..GroundAhead::recommended() },
         GroundAhead { iterations: 0, ..GroundAhead::recommended() },
         GroundAhead { steep_tilt: 4.0, ..GroundAhead::recommended() },
+        GroundAhead { ledge_share: 1.5, ..GroundAhead::recommended() },
+        GroundAhead { ledge_spread: f64::INFINITY, ..GroundAhead::recommended() },
+        GroundAhead { drop_quantile: -0.1, ..GroundAhead::recommended() },
     ] {
         let mut scratch = Default::default();
         assert!(classify_ahead(&floor, 0.45, &limits, &bad, &mut scratch).is_err(), "{bad:?}");
