@@ -5,7 +5,7 @@
 //! finished; `--resume` then skips the cases of the `roadmap` matrix already in the results
 //! file for the same git revision (a case key holds the scene, backend, planner and seed). After
 //! a run of the matrix its rows of this revision are also written as OMPL benchmark logs, one per
-//! scene and backend, under `target/bench/ompl/` (see [`crate::ompl_log`]).
+//! scene and backend, under `target/bench/ompl/` (see [`evaluation::ompl_log`]).
 //!
 //! # The lab's maps from scans
 //! The matrix's `lab-scans-*` scenes (thesis Fig 6.4 as the thesis ran it) and the

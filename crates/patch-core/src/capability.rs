@@ -10,7 +10,7 @@
 //! | [`SpecificStepIntersector<S>`] | Specific{Line,Capsule}Intersector | where does it first hit what? |
 //!
 //! The step type `S` is [`LineStep`](crate::LineStep) (the line intersectors) or
-//! [`CapsuleStep`](crate::CapsuleStep) (the capsule intersectors); a backend implements the
+//! [`CapsuleStep`] (the capsule intersectors); a backend implements the
 //! step intersectors for the step types it supports.
 //!
 //! # The collision contract

@@ -4,8 +4,8 @@
 //! moved (PLY stores doubles, PCD floats, XYZ exact decimal text).
 //!
 //! ```sh
-//! cargo run -p pointcloud --example read_write
-//! cargo run -p pointcloud --example read_write -- fixtures/lab-alrf-2deg.ply
+//! cargo run -p patchnav-pointcloud --example read_write
+//! cargo run -p patchnav-pointcloud --example read_write -- fixtures/lab-alrf-2deg.ply
 //! ```
 
 use pointcloud::io::{ReadOptions, read_cloud, write_cloud};

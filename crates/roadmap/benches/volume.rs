@@ -6,7 +6,7 @@
 //! thesis's 38.7 mm) and `N` = 1024 (11.7 mm cells); throughput in capsules per second.
 //! `count_not_in` and `union_with` run on two grids of 2,000 such capsules each.
 //!
-//! Run with `cargo bench -p roadmap --bench volume -- --warm-up-time 1 --measurement-time 3`.
+//! Run with `cargo bench -p patchnav-roadmap --bench volume -- --warm-up-time 1 --measurement-time 3`.
 //! The 10,000-capsule measurement of the issue is the ignored test `rasterise_lab_scale_timing`
 //! in `tests/it/volume.rs`.
 

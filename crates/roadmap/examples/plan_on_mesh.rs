@@ -1,6 +1,6 @@
 //! Plans on a triangle mesh: the faces of an OBJ file become planar patches of a 6D bounding-box
 //! map (`patch-map`), and a seeded RRT looks for a path of a 0.3 m sphere from start to goal.
-//! Run `cargo run -p roadmap --example plan_on_mesh` (the room of `examples/data/room.obj`), or
+//! Run `cargo run -p patchnav-roadmap --example plan_on_mesh` (the room of `examples/data/room.obj`), or
 //! pass a mesh (metres, z up), start and goal: `-- floorplan.obj 10,7.5,1.25 1.5,1.5,1.25`.
 use patch_map::{BBox6dMap, map_from_obj};
 use roadmap::{AnyOf, Goal, GoalReached, MaxIterations, PatchMap, Planner, PlanningSpace, Point3};

@@ -139,7 +139,7 @@
 //!
 //! The points, boxes and map trait of these signatures ([`Point3`], [`Aabb`], [`Real`],
 //! [`PatchMap`]) are `patch-core`'s, re-exported here. `examples/plan_on_mesh.rs` plans on an
-//! OBJ mesh in a `patch-map` backend (`cargo run -p roadmap --example plan_on_mesh`).
+//! OBJ mesh in a `patch-map` backend (`cargo run -p patchnav-roadmap --example plan_on_mesh`).
 //!
 //! # Features
 //! `problem-file` (off by default) adds `ProblemFile`, the planning problem file of the shared

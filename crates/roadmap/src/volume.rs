@@ -52,7 +52,7 @@
 //! million voxels in 86,897 bricks (42 MiB of bricks, 66 MiB by capacity); `count_not_in` of
 //! two such grids takes about 30 ms. The cost is per row, so
 //! it falls with the square of the cell size: at 256³ (46.9 mm, near the thesis's 38.7 mm) a
-//! capsule takes about 65 µs (`cargo bench -p roadmap --bench volume`).
+//! capsule takes about 65 µs (`cargo bench -p patchnav-roadmap --bench volume`).
 //!
 //! # Example
 //! ```

@@ -6,8 +6,8 @@
 //!   triangle mesh; start at the south-east, goals in the rack and across the room.
 //!
 //! Every problem runs in three modes with the same budget on both sides: `explore` (exactly
-//! [`EXPLORE_ITERATIONS`] iterations: time per iteration), `solve` (start → each goal, stop at
-//! the goal or after [`SOLVE_ITERATIONS`]: time to solve, success, path length) and `roi` (all
+//! `EXPLORE_ITERATIONS` iterations: time per iteration), `solve` (start → each goal, stop at
+//! the goal or after `SOLVE_ITERATIONS`: time to solve, success, path length) and `roi` (all
 //! goals with one tree / roadmap, same budget). Ours runs on the polygon, bbox6d and trimesh
 //! backends; theirs on FCL's OBBRSS BVH of the same triangles.
 

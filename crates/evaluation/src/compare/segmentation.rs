@@ -5,16 +5,16 @@
 //!   against the floor plan's mesh with the scoring of `cargo xtask peers planes`
 //!   ([`crate::peers::Truth`]);
 //! * **lab**: [`LAB_FRAMES`] simulated range-camera frames of the lab scene (scene-sim's
-//!   SR-3000 model, 176 × 144, seed [`LAB_SEED`], poses from [`lab_poses`]), written as organised
+//!   SR-3000 model, 176 × 144, seed [`LAB_SEED`], poses from `lab_poses`), written as organised
 //!   PLY files with surface labels under `target/compare/segmentation/lab/` and scored by the
-//!   same rules against the scene's exact surfaces ([`truth::SceneTruth`]);
-//! * **real**: the organised depth and ToF frames of the real-data folder (see [`REAL_FRAMES`]),
+//!   same rules against the scene's exact surfaces (`truth::SceneTruth`);
+//! * **real**: the organised depth and ToF frames of the real-data folder (see `REAL_FRAMES`),
 //!   converted by `patchnav` into organised PLY files under `target/compare/segmentation/real/`
 //!   so both sides read the same points. They have no ground truth: the rows give time, planes
 //!   and the share of valid points assigned to a plane. A missing folder or frame is skipped
 //!   with a printed note.
 //!
-//! Every input runs [`REPS`] times per side, alternating; one JSONL row per run and side. The
+//! Every input runs `REPS` times per side, alternating; one JSONL row per run and side. The
 //! text is a table for the scored inputs, one for the real frames, and an overall table: per set
 //! and over all inputs, the median of the per-input ratios ours / theirs of the median times,
 //! and the quality of both sides.
@@ -183,7 +183,7 @@ struct Input {
     sensor: &'static str,
 }
 
-/// Runs both sides [`REPS`] times on every input; returns the rows and the tables.
+/// Runs both sides `REPS` times on every input; returns the rows and the tables.
 pub fn run_with(env: &Env, options: &Options) -> Result<(Vec<Value>, String)> {
     if !(1..=64).contains(&options.lab_frames) {
         bail!("the lab frames must be between 1 and 64, got {}", options.lab_frames);

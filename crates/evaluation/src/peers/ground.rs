@@ -143,7 +143,7 @@ pub struct GroundRun {
     pub seeds: Vec<u64>,
 }
 
-/// The simulated scenes (terrain scenes of scene-sim and the lab); [`sim_scene`] says which of
+/// The simulated scenes (terrain scenes of scene-sim and the lab); `sim_scene` says which of
 /// their surfaces are drivable ground.
 pub const SIM_SCENES: [&str; 9] = [
     "floor",

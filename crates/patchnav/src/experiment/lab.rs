@@ -1,5 +1,5 @@
 //! The command line of `patchnav experiment lab-timing` and `lab-volume`: arguments that
-//! become [`patch_pipeline::lab`]'s settings; the experiments themselves live there.
+//! become [`patch_pipeline::experiment::lab`]'s settings; the experiments themselves live there.
 
 use anyhow::Result;
 use clap::Args;

@@ -1,4 +1,4 @@
-//! Integration tests of `pointcloud`, one binary (`cargo test -p pointcloud --test it`).
+//! Integration tests of `pointcloud`, one binary (`cargo test -p patchnav-pointcloud --test it`).
 
 mod cloud_paths;
 mod common;

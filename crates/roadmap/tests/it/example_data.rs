@@ -1,7 +1,7 @@
 //! `examples/data/room.obj`, the mesh `examples/plan_on_mesh.rs` plans on, is made here: an
 //! 8 m × 6 m × 2.5 m room with two partitions that force an S-shaped path from (1, 1, 1) to
 //! (7, 5, 1) and a low crate a robot can pass over. The test fails if the committed file differs
-//! from what this code makes; `UPDATE_EXAMPLE_DATA=1 cargo test -p roadmap --test it example_data::`
+//! from what this code makes; `UPDATE_EXAMPLE_DATA=1 cargo test -p patchnav-roadmap --test it example_data::`
 //! rewrites it.
 
 use pointcloud::io::obj::write_obj;
@@ -65,7 +65,7 @@ fn room_obj_is_current() {
     let committed = std::fs::read(&path).unwrap_or_default();
     assert!(
         committed == obj,
-        "{} is stale: run `UPDATE_EXAMPLE_DATA=1 cargo test -p roadmap --test it example_data::`",
+        "{} is stale: run `UPDATE_EXAMPLE_DATA=1 cargo test -p patchnav-roadmap --test it example_data::`",
         path.display()
     );
 }

@@ -1,4 +1,4 @@
-//! Integration tests of `roadmap`, one binary (`cargo test -p roadmap --test it`).
+//! Integration tests of `roadmap`, one binary (`cargo test -p patchnav-roadmap --test it`).
 
 mod common;
 mod connect;

@@ -487,7 +487,7 @@ fn congruence_table_of_known_maps() {
 
 /// The lab-scale measurement of the issue: 10,000 random 1 m capsules of radius 0.3 m in a
 /// 1024³ grid over a 12 × 9 × 4 m box. Run with
-/// `cargo test --release -p roadmap --test it volume:: -- --ignored --nocapture rasterise_lab`.
+/// `cargo test --release -p patchnav-roadmap --test it volume:: -- --ignored --nocapture rasterise_lab`.
 #[test]
 #[ignore = "timing; run in release"]
 fn rasterise_lab_scale_timing() {
