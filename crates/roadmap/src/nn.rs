@@ -212,6 +212,37 @@ impl NearestNeighbors for KdNeighbors {
         out.truncate(k);
         out
     }
+
+    /// [`k_nearest`](NearestNeighbors::k_nearest) with `k = 1`, without allocating: one
+    /// exact nearest-one query per tree (RRT's hot path).
+    fn nearest(&self, query: &Point3) -> Option<Neighbor> {
+        let mut best: Option<Neighbor> = None;
+        let mut consider = |index: usize, p: &Point3| {
+            let n = Neighbor { index, distance: (p - query).norm() };
+            let closer = |b: &Neighbor| {
+                n.distance.total_cmp(&b.distance).then(n.index.cmp(&b.index)).is_lt()
+            };
+            if best.as_ref().is_none_or(closer) {
+                best = Some(n);
+            }
+        };
+        for (i, p) in &self.buffer {
+            consider(*i, p);
+        }
+        let q = [query.x, query.y, query.z];
+        for level in self.levels.iter().flatten() {
+            let mut at =
+                |item: usize| consider(level.indices[item], &Point3::from(level.points[item]));
+            match &level.tree {
+                Some(tree) => {
+                    at(tree.query(&q).nearest_one::<SquaredEuclidean<Real>>().execute().item
+                        as usize)
+                }
+                None => (0..level.points.len()).for_each(at),
+            }
+        }
+        best
+    }
 }
 
 #[cfg(test)]
@@ -280,7 +311,11 @@ mod proptests {
                     for n in &a {
                         prop_assert_eq!((points[n.index] - q).norm(), n.distance);
                     }
-                    prop_assert_eq!(kd.nearest(q).map(|n| n.distance), linear.nearest(q).map(|n| n.distance));
+                    let one = kd.nearest(q);
+                    prop_assert_eq!(one.map(|n| n.distance), linear.nearest(q).map(|n| n.distance));
+                    if let Some(n) = one {
+                        prop_assert_eq!((points[n.index] - q).norm(), n.distance);
+                    }
                 }
             }
             kd.clear();
