@@ -250,12 +250,12 @@ pub fn run(scale: Scale, seed: u64, out: &Path, progress: &dyn Progress) -> Resu
     let spinner = progress.spinner("time-of-flight frame");
     let tof = sensors::tof(seed, &mut files)?;
     spinner.finish_and_clear();
-    clock.lap("ToF: simulate, AAT + unwrap");
+    clock.lap("ToF: simulate, region unwrapping");
 
     let spinner = progress.spinner("terrain snapshot");
     let terrain = sensors::terrain(seed, &mut files)?;
     spinner.finish_and_clear();
-    clock.lap("terrain: simulate, Hough classify");
+    clock.lap("terrain: simulate, classify");
 
     let spinner = progress.spinner("scanning the lab");
     let lab = maps::scan_lab(seed, &settings, &mut files)?;

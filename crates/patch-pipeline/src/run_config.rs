@@ -39,9 +39,10 @@
 //! | `plan.max_iterations` | `10000` | iteration budget of a run (it stops once every goal is reached) |
 //! | `tof.range`, `tof.amplitude`, `tof.meta` | — (required in `[tof]`) | a 16-bit PNG pair and its JSON sidecar, as `patchnav tof filter` reads |
 //! | `tof.confidence` | none | optional confidence PNG |
-//! | `tof.aat` | the sidecar's (thesis: 0.2) | AAT threshold |
-//! | `tof.unwrap` | `true` | unwrap the flagged pixels instead of dropping them |
-//! | `tof.low_at` | none | with `unwrap`: drop flagged pixels with amplitude ≤ this |
+//! | `tof.method` | `regions` | `regions` (region unwrapping: unwraps only where a region agrees), `aat` (the thesis's adaptive amplitude threshold) or `at` (plain threshold 160) |
+//! | `tof.aat` | the sidecar's (thesis: 0.2) | AAT threshold (also the evidence of `regions`) |
+//! | `tof.unwrap` | `false` | with `method = "aat"`: unwrap the flagged pixels instead of dropping them |
+//! | `tof.low_at` | none | drop pixels with amplitude ≤ this before segmenting (`regions`), or flagged ones instead of unwrapping them (`aat` with `unwrap`) |
 //! | `terrain.frame` | — (required in `[terrain]`) | a range frame, as `patchnav terrain` reads |
 //! | `terrain.resolution` | `15.0` | Hough angular resolution, degrees |
 //! | `terrain.sensor_height` | `0.45` | metres above the floor |

@@ -103,6 +103,7 @@ struct RawTof {
     amplitude: PathBuf,
     meta: PathBuf,
     confidence: Option<PathBuf>,
+    method: Option<String>,
     aat: Option<Real>,
     unwrap: Option<bool>,
     low_at: Option<Real>,
@@ -196,11 +197,14 @@ pub struct TofConfig {
     pub meta: PathBuf,
     /// Optional confidence PNG.
     pub confidence: Option<PathBuf>,
+    /// The filter: region unwrapping (the default), the AAT or the plain AT.
+    pub method: crate::tof::Method,
     /// AAT override.
     pub aat: Option<Real>,
-    /// Unwrap flagged pixels instead of dropping them.
+    /// With the AAT: unwrap flagged pixels instead of dropping them.
     pub unwrap: bool,
-    /// With `unwrap`: drop flagged pixels with amplitude ≤ this.
+    /// Drop pixels with amplitude ≤ this: before segmenting (regions), or the flagged ones
+    /// instead of unwrapping them (AAT with `unwrap`).
     pub low_at: Option<Real>,
 }
 
@@ -615,10 +619,27 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
             {
                 bail!("tof.aat must be a positive threshold, not {a}");
             }
-            let unwrap = t.unwrap.unwrap_or(true);
+            use crate::tof::Method;
+            let method = t
+                .method
+                .as_deref()
+                .map_or(Ok(Method::Regions), |m| named("tof.method", m, names::all()))?;
+            if method == Method::TwoFreq {
+                bail!("tof.method: two-freq needs a second frame, which [tof] does not take");
+            }
+            let unwrap = t.unwrap.unwrap_or(false);
+            if unwrap && method != Method::Aat {
+                bail!(
+                    "tof.unwrap = true needs tof.method = \"aat\" (region unwrapping decides \
+                     what to unwrap itself)"
+                );
+            }
             if let Some(l) = t.low_at {
-                if !unwrap {
-                    bail!("tof.low_at applies only with tof.unwrap = true");
+                if !(unwrap || method == Method::Regions) {
+                    bail!(
+                        "tof.low_at applies only with tof.method = \"regions\" or with \
+                         tof.unwrap = true"
+                    );
                 }
                 if !(l.is_finite() && l >= 0.0) {
                     bail!("tof.low_at must be a non-negative amplitude, not {l}");
@@ -633,6 +654,7 @@ fn resolve(raw: RawConfig, base: &Path, path: &Path) -> Result<Config> {
                     .as_deref()
                     .map(|c| existing("tof.confidence", base, c))
                     .transpose()?,
+                method,
                 aat: t.aat,
                 unwrap,
                 low_at: t.low_at,
@@ -825,6 +847,36 @@ mod tests {
         let text = "[input]\ncloud = \"a.ply\"\n[plan]\nstart = [0, nan, 1]\ngoals = [[1, 0, 1]]\n";
         let e = load(&write(dir.path(), text)).unwrap_err().to_string();
         assert!(e.contains("plan.start"), "{e}");
+    }
+
+    #[test]
+    fn tof_defaults_to_region_unwrapping_and_unwrap_needs_the_aat() {
+        use crate::tof::Method;
+        let dir = tempfile::tempdir().unwrap();
+        for f in ["r.png", "a.png", "m.json"] {
+            std::fs::write(dir.path().join(f), "").unwrap();
+        }
+        let tof = |keys: &str| {
+            let text = format!(
+                "[input]\ncloud = \"a.ply\"\n{PLAN}[tof]\nrange = \"r.png\"\namplitude = \"a.png\"\n\
+                 meta = \"m.json\"\n{keys}"
+            );
+            load(&write(dir.path(), &text))
+        };
+        let t = tof("").unwrap().tof.unwrap();
+        assert_eq!((t.method, t.unwrap, t.low_at), (Method::Regions, false, None));
+        let t = tof("method = \"aat\"\nunwrap = true\nlow_at = 20.0\n").unwrap().tof.unwrap();
+        assert_eq!((t.method, t.unwrap, t.low_at), (Method::Aat, true, Some(20.0)));
+        assert_eq!(tof("low_at = 50.0\n").unwrap().tof.unwrap().low_at, Some(50.0));
+        for (keys, needle) in [
+            ("unwrap = true\n", "tof.unwrap"),
+            ("method = \"aat\"\nlow_at = 20.0\n", "tof.low_at"),
+            ("method = \"two-freq\"\n", "tof.method"),
+            ("method = \"fold\"\n", "tof.method"),
+        ] {
+            let e = tof(keys).unwrap_err().to_string();
+            assert!(e.contains(needle), "{keys}: {e}");
+        }
     }
 
     #[test]

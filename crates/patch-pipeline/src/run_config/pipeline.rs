@@ -17,7 +17,7 @@ use crate::results::{
 };
 use crate::scene_map::{MapKind, SceneSurfaces, Tessellation, patch_map};
 use crate::terrain::TerrainSetup;
-use crate::tof::{FilterSetup, FrameSource, Method, filter_frame};
+use crate::tof::{FilterSetup, FrameSource, filter_frame};
 use anyhow::{Context, Result, bail};
 use hough_terrain::{HistogramStyle, hough_png};
 use patch_core::{CapsuleStep, Patch, Point3, UnspecificStepIntersector};
@@ -478,8 +478,8 @@ fn plan(
     Ok((runs, skipped))
 }
 
-/// Filters the ToF frame with the AAT (and unwrapping), as `patchnav tof filter --method aat
-/// [--unwrap]` does, and writes the output cloud (`tof-cloud.ply`). Without the truth of a
+/// Filters the ToF frame as `patchnav tof filter --method M` does (region unwrapping by
+/// default) and writes the output cloud (`tof-cloud.ply`). Without the truth of a
 /// simulation, the wrapped, unwrapped-correctly and wrong percentages are unknown (NaN; `null`
 /// in `results.json`, a dash in the report).
 fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
@@ -491,7 +491,7 @@ fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
             meta: t.meta.clone(),
         },
         cloud: None,
-        method: Method::Aat,
+        method: t.method,
         at: 160.0,
         aat: t.aat,
         calibration: None,
@@ -596,7 +596,7 @@ pub fn run(config: &Config, progress: &dyn Progress) -> Result<(DemoResults, Vec
     let tof = match &config.tof {
         Some(t) => {
             let section = tof(t, &mut files, config.write_3d)?;
-            clock.lap("ToF: AAT + unwrap");
+            clock.lap("ToF: filter");
             Some(section)
         }
         None => None,
@@ -604,7 +604,7 @@ pub fn run(config: &Config, progress: &dyn Progress) -> Result<(DemoResults, Vec
     let terrain = match &config.terrain {
         Some(t) => {
             let section = terrain(t, &mut files)?;
-            clock.lap("terrain: Hough classify");
+            clock.lap("terrain: classify");
             Some(section)
         }
         None => None,

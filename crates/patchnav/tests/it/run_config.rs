@@ -95,9 +95,11 @@ fn lab_scans_with_poses_tof_and_terrain() {
     assert!(plans.iter().any(|p| p["solved"] == true), "no plan solved");
     assert!(r["tof"]["outcomes"].as_array().unwrap().len() == 176 * 144);
     assert!(r["tof"]["discarded_percent"].as_f64().is_some());
-    // The rack-and-door frame wraps: the AAT flags part of it and unwrapping keeps those pixels.
+    // The rack-and-door frame wraps: region unwrapping (the default) keeps part of it and
+    // drops what stays ambiguous.
     let outcomes = r["tof"]["outcomes"].as_array().unwrap();
-    assert!(outcomes.iter().any(|o| o == 0) && outcomes.iter().any(|o| o == 1));
+    assert!(outcomes.iter().any(|o| o == 0) && outcomes.iter().any(|o| o == 2));
+    assert!(r["tof"]["method"].as_str().unwrap().starts_with("regions"), "{}", r["tof"]["method"]);
     assert_eq!(r["terrain"]["sectors"].as_array().unwrap().len(), 3);
     // The fixture is a stereo frame of a ramp (camera axes).
     assert_eq!(r["terrain"]["class"], "ramp");
