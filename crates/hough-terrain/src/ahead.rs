@@ -210,14 +210,19 @@ impl GroundAhead {
                 allowed: "[0.0006°, 28°]",
             });
         }
-        for (what, v) in [("ledge_rise", self.ledge_rise), ("ledge_spread", self.ledge_spread)] {
-            if !(-1e3..=1e3).contains(&v) {
-                return Err(HoughError::BadParameter {
-                    what,
-                    value: v,
-                    allowed: "[-1000, 1000] m",
-                });
-            }
+        if !(-1e3..=1e3).contains(&self.ledge_rise) {
+            return Err(HoughError::BadParameter {
+                what: "ledge_rise",
+                value: self.ledge_rise,
+                allowed: "[-1000, 1000] m",
+            });
+        }
+        if !(0.0..=1e3).contains(&self.ledge_spread) {
+            return Err(HoughError::BadParameter {
+                what: "ledge_spread",
+                value: self.ledge_spread,
+                allowed: "[0, 1000] m",
+            });
         }
         if !(self.max_gap.is_finite() && self.max_gap >= 0.0) {
             return Err(HoughError::BadParameter {
@@ -606,9 +611,10 @@ fn ground_break(
 }
 
 /// The height of a ledge ahead, if the nearest standing columns form one: in at least
-/// `ledge_share` of the lateral rows that show points up to the farthest of them, with top edges that agree within
-/// `ledge_spread` and lie at most `ledge_rise` above the sensor (a plateau too high to climb
-/// whose face spans the view; a wall's columns end at the view's upper edge instead).
+/// `ledge_share` of the lateral rows that show points up to the farthest of them, with top
+/// edges that agree within `ledge_spread` and lie at most `ledge_rise` above the sensor (a
+/// plateau too high to climb whose face spans the view; a wall's columns end at the view's
+/// upper edge instead).
 fn ledge(rule: &GroundAhead, height: f64, scratch: &mut AheadScratch, nx: usize) -> Option<f64> {
     // Range noise scatters points along the beams, beyond the face and out to the side: only
     // cells up to the farthest front count.
