@@ -1,0 +1,5 @@
+//! Integration tests of `ros-bag`, one binary (`cargo test -p patchnav-ros-bag --test it`).
+
+mod fixture;
+mod hostile;
+mod round_trip;
