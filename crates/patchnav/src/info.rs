@@ -14,15 +14,9 @@ pub fn run(file: &Path, input: &InputArgs) -> Result<()> {
     Ok(())
 }
 
-/// Whether `path` names a ROS bag: a folder (rosbag2), `.mcap`, `.bag` or `.db3`.
-fn is_bag(path: &Path) -> bool {
-    path.is_dir()
-        || matches!(path.extension().and_then(|e| e.to_str()), Some("mcap" | "bag" | "db3"))
-}
-
 /// The text `info` prints for `file`.
 pub fn describe(file: &Path, input: &InputArgs) -> Result<String> {
-    if is_bag(file) {
+    if crate::extract::is_bag(file) {
         return describe_bag(file);
     }
     let format = Format::from_path(file)

@@ -4,7 +4,7 @@
 //! patchnav info FILE|BAG                  what a file or a ROS bag holds
 //! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
-//! patchnav extract SCANS... --out MAP [--sensor alrf|range-camera|structured-light|exact] [--hybrid] [--export F.obj|F.ply]
+//! patchnav extract SCANS...|BAG --out MAP [--topic T] [--sensor alrf|range-camera|structured-light|exact] [--hybrid] [--export F.obj|F.ply]
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
 //! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]

@@ -1,5 +1,6 @@
 //! The one error type of this crate.
 
+use crate::tf::TfError;
 use crate::wire::WireError;
 use pointcloud::io::pointcloud2::Pc2Error;
 use std::path::PathBuf;
@@ -93,6 +94,18 @@ pub enum BagError {
         topic: String,
         /// What is wrong with the cloud.
         source: Pc2Error,
+    },
+    /// A cloud whose transform to the fixed frame cannot be looked up.
+    #[error("{}, byte {offset}, topic {topic}: {source}", path.display())]
+    Tf {
+        /// The file.
+        path: PathBuf,
+        /// Where the cloud is.
+        offset: u64,
+        /// Its topic.
+        topic: String,
+        /// The broken chain or the missing time.
+        source: Box<TfError>,
     },
     /// A bag could not be written.
     #[error("writing a bag: {0}")]

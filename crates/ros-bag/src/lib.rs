@@ -7,6 +7,8 @@
 //!   `sensor_msgs/PointCloud2` as a [`pointcloud::PointCloud`], organised clouds kept
 //!   organised), [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
 //! * [`BagInfo::of`]: topics, types, counts, time span and frames.
+//! * [`read_scans`]: the clouds of a topic, picked by time window, count or motion, each posed
+//!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated).
 //! * [`BagWriter`]: small MCAP and ROS 1 bags of clouds and transforms (fixtures and tests).
 //!
 //! # Crates and what is written here
@@ -29,6 +31,8 @@ mod decode;
 mod error;
 mod info;
 pub mod msgs;
+mod scans;
+pub mod tf;
 pub mod wire;
 mod write;
 
@@ -36,4 +40,6 @@ pub use bag::{Bag, BagFormat, MessageRef};
 pub use error::BagError;
 pub use info::{BagInfo, TopicInfo};
 pub use msgs::{Header, PointCloud2Msg, TransformStamped};
+pub use scans::{BagScan, BagScans, ScanQuery, read_scans};
+pub use tf::{TfError, TfTree};
 pub use write::{BagWriter, TopicId};

@@ -119,3 +119,31 @@ fn info_lists_topics_counts_span_and_frames() {
         assert_eq!(info.transforms.len(), 2);
     }
 }
+
+#[test]
+fn read_scans_poses_each_cloud_by_the_transform_chain() {
+    let scans = fixture::scans(3);
+    let dir = tempfile::tempdir().unwrap();
+    for (format, name) in [(BagFormat::Mcap, "p.mcap"), (BagFormat::Ros1, "p.bag")] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, fixture::bag(format, &scans)).unwrap();
+        let bag = Bag::open(&path).unwrap();
+        let found = ros_bag::read_scans(&bag, &ros_bag::ScanQuery::all("/points")).unwrap();
+        assert_eq!(found.fixed_frame.as_deref(), Some("odom"));
+        assert_eq!(found.counts, (3, 3, 3));
+        assert!(found.warnings.is_empty());
+        for (got, s) in found.scans.iter().zip(&scans) {
+            assert_eq!(got.stamp_ns, s.stamp_ns);
+            let pose = got.cloud.sensor_pose().unwrap().world_from_sensor;
+            let d = (pose.to_homogeneous() - s.odom_from_sensor.to_homogeneous()).abs().max();
+            assert!(d < 1e-12, "{d}");
+        }
+        let mut query = ros_bag::ScanQuery::all("/points_flat");
+        query.fixed_frame = Some("map".into());
+        let err = ros_bag::read_scans(&bag, &query).unwrap_err();
+        assert!(
+            matches!(&err, ros_bag::BagError::Tf { topic, .. } if topic == "/points_flat"),
+            "{err}"
+        );
+    }
+}
