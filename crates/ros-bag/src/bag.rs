@@ -74,7 +74,7 @@ pub struct Bag {
 /// The longest MCAP record read, relative to the file size: a hostile length cannot make the
 /// reader allocate more than this (decompressed chunks may be larger than the file).
 fn record_limit(file_len: u64) -> usize {
-    (file_len.saturating_mul(16)).clamp(64 << 20, 4 << 30) as usize
+    file_len.saturating_mul(16).clamp(1 << 20, 4 << 30) as usize
 }
 
 impl Bag {
@@ -223,9 +223,9 @@ fn read_mcap(
     Ok(())
 }
 
-/// The ROS 1 bag header's `index_pos` and the end of the header record, checked against the
+/// The end of the ROS 1 bag header record and the header's `index_pos`, checked against the
 /// file length: the `rosbag` crate slices the file by them.
-fn ros1_index_pos(path: &Path, len: u64) -> Result<u64, BagError> {
+fn ros1_index_pos(path: &Path, len: u64) -> Result<(u64, u64), BagError> {
     let io = |e| BagError::Io { path: path.to_owned(), source: e };
     let container = |offset: u64, reason: &str| BagError::Container {
         path: path.to_owned(),
@@ -278,7 +278,54 @@ fn ros1_index_pos(path: &Path, len: u64) -> Result<u64, BagError> {
             ),
         });
     }
-    Ok(index_pos)
+    Ok((start, index_pos))
+}
+
+/// Walks the record headers of the chunk section and refuses a chunk whose declared
+/// uncompressed size is out of proportion to its data: the `rosbag` crate reserves that size
+/// before decompressing.
+fn check_ros1_chunks(path: &Path, start: u64, index_pos: u64) -> Result<(), BagError> {
+    use std::io::{Seek, SeekFrom};
+    let io = |e| BagError::Io { path: path.to_owned(), source: e };
+    let container =
+        |offset: u64, reason: String| BagError::Container { path: path.to_owned(), offset, reason };
+    let mut file = File::open(path).map_err(io)?;
+    let mut at = start;
+    let mut word = [0u8; 4];
+    while at < index_pos {
+        file.seek(SeekFrom::Start(at)).map_err(io)?;
+        file.read_exact(&mut word).map_err(|_| container(at, "truncated record".into()))?;
+        let header_len = u32::from_le_bytes(word) as u64;
+        if at + 8 + header_len > index_pos {
+            return Err(container(at, format!("a record header of {header_len} bytes")));
+        }
+        let mut header = vec![0u8; header_len as usize];
+        file.read_exact(&mut header).map_err(|_| container(at, "truncated record".into()))?;
+        file.read_exact(&mut word).map_err(|_| container(at, "truncated record".into()))?;
+        let data_len = u32::from_le_bytes(word) as u64;
+        let mut size = None;
+        let mut rest = &header[..];
+        while rest.len() >= 4 {
+            let n = u32::from_le_bytes([rest[0], rest[1], rest[2], rest[3]]) as usize;
+            let Some(field) = rest.get(4..4 + n) else { break };
+            if let Some(v) = field.strip_prefix(b"size=")
+                && let Ok(b) = <[u8; 4]>::try_from(v)
+            {
+                size = Some(u32::from_le_bytes(b) as u64);
+            }
+            rest = &rest[4 + n..];
+        }
+        if let Some(size) = size
+            && size > data_len.saturating_mul(1024) + (1 << 20)
+        {
+            return Err(container(
+                at,
+                format!("a chunk claims {size} bytes uncompressed from {data_len} bytes"),
+            ));
+        }
+        at += 8 + header_len + data_len;
+    }
+    Ok(())
 }
 
 fn read_ros1(
@@ -287,7 +334,8 @@ fn read_ros1(
 ) -> Result<(), BagError> {
     let io = |e| BagError::Io { path: path.to_owned(), source: e };
     let len = std::fs::metadata(path).map_err(io)?.len();
-    let index_pos = ros1_index_pos(path, len)?;
+    let (start, index_pos) = ros1_index_pos(path, len)?;
+    check_ros1_chunks(path, start, index_pos)?;
     let container =
         |offset: u64, reason: String| BagError::Container { path: path.to_owned(), offset, reason };
     let bag = rosbag::RosBag::new(path).map_err(|e| container(0, e.to_string()))?;

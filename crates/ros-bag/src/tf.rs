@@ -52,8 +52,8 @@ struct Edge {
 /// time-stamped samples.
 ///
 /// [`TfTree::lookup`] interpolates between the two samples around the time (linearly in the
-/// translation, spherically in the rotation), returns a sample exactly at its own stamp, and
-/// does not extrapolate. A later parent for a child replaces the earlier one (as tf does).
+/// translation, spherically in the rotation; where that is ambiguous it takes the nearer
+/// sample), returns a sample exactly at its own stamp, and does not extrapolate. A later parent for a child replaces the earlier one (as tf does).
 #[derive(Clone, Debug, Default)]
 pub struct TfTree {
     edges: HashMap<String, Edge>,
@@ -126,7 +126,8 @@ impl TfTree {
             (Some(&(t, m)), _) if t == stamp_ns => Ok(m),
             (Some(&(t1, m1)), Some(&(t0, m0))) => {
                 let a = (stamp_ns - t0) as f64 / (t1 - t0) as f64;
-                Ok(m0.lerp_slerp(&m1, a))
+                // Where slerp is ambiguous (opposite quaternions), take the nearer sample.
+                Ok(m0.try_lerp_slerp(&m1, a, 1e-12).unwrap_or(if a < 0.5 { m0 } else { m1 }))
             }
             _ => Err(out_of_range()),
         }
@@ -220,5 +221,31 @@ mod tests {
         assert_eq!(tree.lookup("sensor", "sensor", 7).unwrap(), Isometry3::identity());
         assert!(matches!(tree.lookup("odom", "sensor", 250), Err(TfError::OutOfRange { .. })));
         assert!(matches!(tree.lookup("map", "sensor", 150), Err(TfError::NoPath { .. })));
+    }
+
+    #[test]
+    fn half_turns_and_negated_quaternions_interpolate_without_panic() {
+        let mut tree = TfTree::new();
+        let half = Isometry3::rotation(Vector3::z() * std::f64::consts::PI);
+        let samples = [t(0, "odom", "base", Isometry3::identity()), t(10, "odom", "base", half)];
+        tree.insert(&samples, false);
+        let yaw = tree.lookup("odom", "base", 4).unwrap().rotation.euler_angles().2;
+        assert!((yaw.abs() - 0.4 * std::f64::consts::PI).abs() < 1e-9, "{yaw}");
+        // The same rotation with the quaternion's sign flipped.
+        let negated = UnitQuaternion::new_unchecked(-*UnitQuaternion::identity().quaternion());
+        let flipped = Isometry3::from_parts(Vector3::zeros().into(), negated);
+        let samples = [t(20, "odom", "b2", Isometry3::identity()), t(30, "odom", "b2", flipped)];
+        tree.insert(&samples, false);
+        let mid = tree.lookup("odom", "b2", 25).unwrap();
+        assert!(mid.rotation.angle() < 1e-9, "{mid}");
+    }
+
+    #[test]
+    fn a_loop_in_the_tree_ends_the_walk() {
+        let mut tree = TfTree::new();
+        let m = Isometry3::translation(1.0, 0.0, 0.0);
+        tree.insert(&[t(0, "a", "b", m), t(0, "b", "a", m)], true);
+        assert!(matches!(tree.lookup("c", "a", 0), Err(TfError::NoPath { .. })));
+        assert!(tree.lookup("b", "a", 0).is_ok());
     }
 }

@@ -176,3 +176,15 @@ fn unknown_paths_and_db3_folders_are_named() {
     let err = read_all(&unindexed).unwrap_err();
     assert!(err.to_string().contains("no index"), "{err}");
 }
+
+#[test]
+fn a_ros1_chunk_claiming_gigabytes_is_refused_before_decompression() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = small_bag(BagFormat::Ros1);
+    let size = bytes.windows(5).position(|w| w == b"size=").unwrap() + 5;
+    bytes[size..size + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    let path = dir.path().join("big.bag");
+    std::fs::write(&path, &bytes).unwrap();
+    let err = read_all(&path).unwrap_err();
+    assert!(err.to_string().contains("a chunk claims 4294967295 bytes"), "{err}");
+}
