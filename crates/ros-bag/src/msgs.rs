@@ -211,32 +211,25 @@ pub fn encode_tf(transforms: &[TransformStamped], encoding: Encoding) -> Vec<u8>
     w.finish()
 }
 
-macro_rules! header_definition {
-    () => {
-        concat!(
-            "================================================================================\n",
-            "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
-        )
-    };
-}
+const SEPARATOR: &str =
+    "================================================================================\n";
 
-/// The message definition text (`ros2msg` / ROS 1 `.msg` with its dependencies) and the ROS 1
-/// MD5 sum of the types this crate writes.
-pub(crate) fn definition(type_name: &str) -> Option<(&'static str, &'static str)> {
-    match type_name {
-        POINT_CLOUD2 => Some((
+/// The message definition text (ROS 2 `ros2msg` or ROS 1 `.msg` with its dependencies, in
+/// the encoding's own `std_msgs/Header`) and the ROS 1 MD5 sum of the types this crate writes.
+pub(crate) fn definition(type_name: &str, encoding: Encoding) -> Option<(String, &'static str)> {
+    let (body, md5) = match type_name {
+        POINT_CLOUD2 => (
             concat!(
-                "std_msgs/Header header\nuint32 height\nuint32 width\nPointField[] fields\nbool is_bigendian\n",
-                "uint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",
+                "std_msgs/Header header\nuint32 height\nuint32 width\nPointField[] fields\n",
+                "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n",
                 "================================================================================\n",
-                "MSG: sensor_msgs/PointField\nuint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\n",
-                "uint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\n",
-                "uint32 offset\nuint8 datatype\nuint32 count\n",
-                header_definition!()
+                "MSG: sensor_msgs/PointField\nuint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\n",
+                "uint8 UINT16=4\nuint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\n",
+                "string name\nuint32 offset\nuint8 datatype\nuint32 count\n",
             ),
             "1158d486dd51d683ce2f1be655c3c181",
-        )),
-        TF_MESSAGE => Some((
+        ),
+        TF_MESSAGE => (
             concat!(
                 "geometry_msgs/TransformStamped[] transforms\n",
                 "================================================================================\n",
@@ -249,10 +242,19 @@ pub(crate) fn definition(type_name: &str) -> Option<(&'static str, &'static str)
                 "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z\n",
                 "================================================================================\n",
                 "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n",
-                header_definition!()
             ),
             "94810edda583a504dfda3829e70d7eec",
-        )),
-        _ => None,
-    }
+        ),
+        _ => return None,
+    };
+    let header = match encoding {
+        Encoding::Ros1 => {
+            "MSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n".to_owned()
+        }
+        Encoding::Cdr => format!(
+            "MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n{SEPARATOR}\
+             MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+        ),
+    };
+    Some((format!("{body}{SEPARATOR}{header}"), md5))
 }

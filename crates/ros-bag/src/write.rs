@@ -65,7 +65,8 @@ impl BagWriter {
     /// Adds a topic of a type (`sensor_msgs/PointCloud2`, `tf2_msgs/TFMessage`; other types
     /// get an empty definition).
     pub fn add_topic(&mut self, name: &str, type_name: &str) -> Result<TopicId, BagError> {
-        let (definition, md5) = msgs::definition(type_name).unwrap_or(("", "*"));
+        let encoding = self.encoding();
+        let (definition, md5) = msgs::definition(type_name, encoding).unwrap_or_default();
         let mut mcap_channel = 0;
         match &mut self.inner {
             Inner::Mcap(w) => {
@@ -80,8 +81,8 @@ impl BagWriter {
             Inner::Ros1(w) => w.connections.push(Ros1Connection {
                 topic: name.to_owned(),
                 type_name: type_name.to_owned(),
-                md5: if md5 == "*" { "0".repeat(32) } else { md5.to_owned() },
-                definition: definition.to_owned(),
+                md5: if md5.is_empty() { "0".repeat(32) } else { md5.to_owned() },
+                definition,
             }),
         }
         self.topics.push(Topic {

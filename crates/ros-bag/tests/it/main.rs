@@ -2,4 +2,5 @@
 
 mod fixture;
 mod hostile;
+mod official_reader;
 mod round_trip;
