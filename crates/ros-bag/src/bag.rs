@@ -54,8 +54,8 @@ pub struct MessageRef<'a> {
     pub log_time_ns: u64,
     /// Its serialised bytes.
     pub data: &'a [u8],
-    /// Where it is: MCAP, the file position just past its record (for compressed chunks, how far
-    /// the chunk had been read); ROS 1, the position of its chunk.
+    /// Where it is: MCAP, the file position just past its record or the chunk holding it;
+    /// ROS 1, the position of its chunk.
     pub offset: u64,
 }
 
@@ -162,6 +162,89 @@ fn encoding_of(name: &str) -> Option<Encoding> {
     }
 }
 
+/// The schemas and channels seen so far in an MCAP file.
+#[derive(Default)]
+struct McapState {
+    schemas: HashMap<u16, String>,
+    /// channel id → (topic, type, encoding)
+    channels: HashMap<u16, (String, String, Option<Encoding>)>,
+}
+
+/// One record outside or inside a chunk; `offset` is the file position past it (or its chunk).
+fn mcap_record(
+    path: &Path,
+    state: &mut McapState,
+    record: mcap::records::Record<'_>,
+    offset: u64,
+    limit: usize,
+    f: &mut dyn FnMut(&MessageRef<'_>) -> Result<(), BagError>,
+) -> Result<(), BagError> {
+    let container = |reason: String| BagError::Container { path: path.to_owned(), offset, reason };
+    match record {
+        mcap::records::Record::Schema { header, .. } => {
+            state.schemas.insert(header.id, normalise_type(&header.name));
+        }
+        mcap::records::Record::Channel(c) => {
+            let type_name = state.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+            let encoding = encoding_of(&c.message_encoding);
+            state.channels.insert(c.id, (c.topic, type_name, encoding));
+        }
+        mcap::records::Record::Message { header, data } => {
+            let (topic, type_name, encoding) =
+                state.channels.get(&header.channel_id).ok_or_else(|| {
+                    container(format!("message on unknown channel {}", header.channel_id))
+                })?;
+            f(&MessageRef {
+                file: path,
+                topic,
+                type_name,
+                encoding: *encoding,
+                log_time_ns: header.log_time,
+                data: &data,
+                offset,
+            })?;
+        }
+        mcap::records::Record::Chunk { header, data } => {
+            if header.compression.is_empty() {
+                // Uncompressed records are walked here, every length checked against the chunk.
+                let mut rest: &[u8] = &data;
+                while !rest.is_empty() {
+                    let Some((&opcode, tail)) = rest.split_first() else { break };
+                    let len = tail
+                        .get(..8)
+                        .map(|b| u64::from_le_bytes(b.try_into().unwrap_or_default()))
+                        .ok_or_else(|| container("a chunk record without its length".into()))?;
+                    let body = usize::try_from(len)
+                        .ok()
+                        .and_then(|n| tail.get(8..8usize.checked_add(n)?))
+                        .ok_or_else(|| {
+                            container(format!("a chunk record of {len} bytes beyond its chunk"))
+                        })?;
+                    let record =
+                        mcap::parse_record(opcode, body).map_err(|e| container(e.to_string()))?;
+                    mcap_record(path, state, record, offset, limit, f)?;
+                    rest = &tail[8 + body.len()..];
+                }
+            } else {
+                if header.uncompressed_size > limit as u64 {
+                    return Err(container(format!(
+                        "a chunk claims {} bytes uncompressed",
+                        header.uncompressed_size
+                    )));
+                }
+                let chunk = mcap::read::ChunkReader::new(header, &data)
+                    .map_err(|e| container(e.to_string()))?;
+                for record in chunk {
+                    let record = record.map_err(|e| container(e.to_string()))?;
+                    mcap_record(path, state, record, offset, limit, f)?;
+                }
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
 fn read_mcap(
     path: &Path,
     f: &mut dyn FnMut(&MessageRef<'_>) -> Result<(), BagError>,
@@ -169,12 +252,14 @@ fn read_mcap(
     let io = |e| BagError::Io { path: path.to_owned(), source: e };
     let mut file = File::open(path).map_err(io)?;
     let len = file.metadata().map_err(io)?.len();
-    let options = LinearReaderOptions::default().with_record_length_limit(record_limit(len));
+    let limit = record_limit(len);
+    // Chunks come whole and are unpacked in `mcap_record`: the reader's own walk through an
+    // uncompressed chunk trusts record lengths (an overflow on a corrupt one).
+    let options =
+        LinearReaderOptions::default().with_record_length_limit(limit).with_emit_chunks(true);
     let mut reader = LinearReader::new_with_options(options);
     let mut fed = 0u64;
-    let mut schemas: HashMap<u16, String> = HashMap::new();
-    // channel id → (topic, type, encoding)
-    let mut channels: HashMap<u16, (String, String, Option<Encoding>)> = HashMap::new();
+    let mut state = McapState::default();
     let container =
         |offset: u64, reason: String| BagError::Container { path: path.to_owned(), offset, reason };
     while let Some(event) = reader.next_event() {
@@ -188,35 +273,7 @@ fn read_mcap(
             LinearReadEvent::Record { data, opcode } => {
                 let record =
                     mcap::parse_record(opcode, data).map_err(|e| container(fed, e.to_string()))?;
-                match record {
-                    mcap::records::Record::Schema { header, .. } => {
-                        schemas.insert(header.id, normalise_type(&header.name));
-                    }
-                    mcap::records::Record::Channel(c) => {
-                        let type_name = schemas.get(&c.schema_id).cloned().unwrap_or_default();
-                        let encoding = encoding_of(&c.message_encoding);
-                        channels.insert(c.id, (c.topic, type_name, encoding));
-                    }
-                    mcap::records::Record::Message { header, data } => {
-                        let (topic, type_name, encoding) =
-                            channels.get(&header.channel_id).ok_or_else(|| {
-                                container(
-                                    fed,
-                                    format!("message on unknown channel {}", header.channel_id),
-                                )
-                            })?;
-                        f(&MessageRef {
-                            file: path,
-                            topic,
-                            type_name,
-                            encoding: *encoding,
-                            log_time_ns: header.log_time,
-                            data: &data,
-                            offset: fed,
-                        })?;
-                    }
-                    _ => {}
-                }
+                mcap_record(path, &mut state, record, fed, limit, f)?;
             }
         }
     }

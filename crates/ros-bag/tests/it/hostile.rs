@@ -51,7 +51,7 @@ fn random_corruption_never_panics() {
         let bytes = small_bag(format);
         let path = dir.path().join(name);
         let mut state = 12345u64;
-        for _ in 0..40 {
+        for _ in 0..300 {
             let mut b = bytes.clone();
             for _ in 0..4 {
                 state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -187,4 +187,18 @@ fn a_ros1_chunk_claiming_gigabytes_is_refused_before_decompression() {
     std::fs::write(&path, &bytes).unwrap();
     let err = read_all(&path).unwrap_err();
     assert!(err.to_string().contains("a chunk claims 4294967295 bytes"), "{err}");
+}
+
+/// A record inside an uncompressed chunk whose length reaches past the chunk (the `mcap`
+/// crate's own walk through chunks overflows on it).
+#[test]
+fn an_mcap_record_longer_than_its_chunk_is_a_container_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bytes = small_bag(BagFormat::Mcap);
+    let name = bytes.windows(22).position(|w| w == b"tf2_msgs/msg/TFMessage").unwrap();
+    assert_eq!(bytes[name - 15], 0x03, "a schema record");
+    bytes[name - 14..name - 6].copy_from_slice(&0xff_ffff_ffffu64.to_le_bytes());
+    let path = dir.path().join("long.mcap");
+    std::fs::write(&path, &bytes).unwrap();
+    assert!(matches!(read_all(&path), Err(BagError::Container { .. })));
 }
