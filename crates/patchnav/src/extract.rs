@@ -51,7 +51,7 @@ pub struct ExtractArgs {
     /// bag (.mcap, a rosbag2 folder, .bag) with --topic.
     #[arg(required = true)]
     pub scans: Vec<PathBuf>,
-    /// The bag's `sensor_msgs/PointCloud2` topic to take scans from.
+    /// The bag's `sensor_msgs/PointCloud2` or `sensor_msgs/LaserScan` topic to take scans from.
     #[arg(long)]
     pub topic: Option<String>,
     /// The frame bag scans are posed in (default: the root of the clouds' transform chain).

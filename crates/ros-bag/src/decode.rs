@@ -2,7 +2,9 @@
 
 use crate::bag::MessageRef;
 use crate::error::BagError;
-use crate::msgs::{self, Header, POINT_CLOUD2, PointCloud2Msg, TF_MESSAGE, TransformStamped};
+use crate::msgs::{
+    self, Header, LASER_SCAN, LaserScan, POINT_CLOUD2, PointCloud2Msg, TF_MESSAGE, TransformStamped,
+};
 use crate::wire::{Encoding, WireError};
 use pointcloud::PointCloud;
 use pointcloud::io::pointcloud2;
@@ -54,9 +56,21 @@ impl MessageRef<'_> {
         PointCloud2Msg::decode(self.data, encoding).map_err(|e| self.wire_error(e))
     }
 
-    /// The message as a cloud in its sensor frame, with its header (see
-    /// [`pointcloud::io::pointcloud2`] for how fields map to the cloud).
+    /// The message as a cloud in its sensor frame, with its header: a `sensor_msgs/PointCloud2`
+    /// (see [`pointcloud::io::pointcloud2`] for how fields map to the cloud) or a
+    /// `sensor_msgs/LaserScan` (see [`LaserScan::to_cloud`]).
     pub fn cloud(&self) -> Result<(Header, PointCloud), BagError> {
+        if self.type_name == LASER_SCAN {
+            let encoding = self.encoding_or_error()?;
+            let scan = LaserScan::decode(self.data, encoding).map_err(|e| self.wire_error(e))?;
+            let cloud = scan.to_cloud().map_err(|e| BagError::Cloud {
+                path: self.file.to_owned(),
+                offset: self.offset,
+                topic: self.topic.to_owned(),
+                source: e.into(),
+            })?;
+            return Ok((scan.header, cloud));
+        }
         let msg = self.point_cloud2()?;
         let cloud = pointcloud2::decode(&msg.cloud).map_err(|source| BagError::Cloud {
             path: self.file.to_owned(),

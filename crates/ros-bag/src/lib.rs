@@ -5,7 +5,7 @@
 //!   `.bag` file; [`Bag::for_each_message`] walks the messages in file order as
 //!   [`MessageRef`]s, which decode themselves: [`MessageRef::cloud`] (a
 //!   `sensor_msgs/PointCloud2` as a [`pointcloud::PointCloud`], organised clouds kept
-//!   organised), [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
+//!   organised, or a `sensor_msgs/LaserScan` as one organised row), [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
 //! * [`BagInfo::of`]: topics, types, counts, time span and frames.
 //! * [`read_scans`]: the clouds of a topic, picked by time window, count or motion, each posed
 //!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated).

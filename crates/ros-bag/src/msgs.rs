@@ -1,12 +1,15 @@
 //! The message types this crate decodes and encodes: `std_msgs/Header`,
-//! `sensor_msgs/PointCloud2` and `tf2_msgs/TFMessage`, in either [`Encoding`].
+//! `sensor_msgs/PointCloud2`, `sensor_msgs/LaserScan` and `tf2_msgs/TFMessage`, in either
+//! [`Encoding`].
 
 use crate::wire::{Encoding, Reader, WireError, Writer};
 use pointcloud::io::pointcloud2::{PointCloud2, PointField};
-use pointcloud::{Isometry3, na};
+use pointcloud::{AttributeError, Isometry3, Point3, PointCloud, na};
 
 /// `sensor_msgs/PointCloud2`.
 pub const POINT_CLOUD2: &str = "sensor_msgs/PointCloud2";
+/// `sensor_msgs/LaserScan`.
+pub const LASER_SCAN: &str = "sensor_msgs/LaserScan";
 /// `tf2_msgs/TFMessage` (on `/tf` and `/tf_static`).
 pub const TF_MESSAGE: &str = "tf2_msgs/TFMessage";
 
@@ -151,6 +154,123 @@ impl PointCloud2Msg {
     }
 }
 
+/// A `sensor_msgs/LaserScan`: ranges of beams in the x-y plane of its frame, counterclockwise
+/// from `angle_min` (0 along x).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct LaserScan {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The first beam's angle (rad).
+    pub angle_min: f32,
+    /// The last beam's angle (rad).
+    pub angle_max: f32,
+    /// The angle between beams (rad).
+    pub angle_increment: f32,
+    /// The time between beams (s).
+    pub time_increment: f32,
+    /// The time between scans (s).
+    pub scan_time: f32,
+    /// Ranges below are no measurement (m).
+    pub range_min: f32,
+    /// Ranges above are no measurement (m).
+    pub range_max: f32,
+    /// One range per beam (m).
+    pub ranges: Vec<f32>,
+    /// One intensity per beam, or none.
+    pub intensities: Vec<f32>,
+}
+
+impl LaserScan {
+    /// Decodes a message.
+    pub fn decode(data: &[u8], encoding: Encoding) -> Result<LaserScan, WireError> {
+        let r = &mut Reader::new(data, encoding)?;
+        let header = Header::read(r, encoding)?;
+        let mut v = [0f32; 7];
+        for (k, name) in [
+            "angle_min",
+            "angle_max",
+            "angle_increment",
+            "time_increment",
+            "scan_time",
+            "range_min",
+            "range_max",
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            v[k] = r.f32(name)?;
+        }
+        let mut floats = |name: &str| -> Result<Vec<f32>, WireError> {
+            let n = r.count(name, 4)?;
+            (0..n).map(|_| r.f32(name)).collect()
+        };
+        let ranges = floats("ranges")?;
+        let intensities = floats("intensities")?;
+        let [
+            angle_min,
+            angle_max,
+            angle_increment,
+            time_increment,
+            scan_time,
+            range_min,
+            range_max,
+        ] = v;
+        Ok(LaserScan {
+            header,
+            angle_min,
+            angle_max,
+            angle_increment,
+            time_increment,
+            scan_time,
+            range_min,
+            range_max,
+            ranges,
+            intensities,
+        })
+    }
+
+    /// Encodes the message.
+    pub fn encode(&self, encoding: Encoding) -> Vec<u8> {
+        let mut w = Writer::new(encoding);
+        self.header.write(&mut w, encoding);
+        for v in [
+            self.angle_min,
+            self.angle_max,
+            self.angle_increment,
+            self.time_increment,
+            self.scan_time,
+            self.range_min,
+            self.range_max,
+        ] {
+            w.f32(v);
+        }
+        for values in [&self.ranges, &self.intensities] {
+            w.u32(values.len() as u32);
+            for &v in values {
+                w.f32(v);
+            }
+        }
+        w.finish()
+    }
+
+    /// The scan as an organised cloud of one row (one pixel per beam) in its frame: a beam
+    /// whose range is not finite or outside `[range_min, range_max]` is an invalid pixel.
+    /// Intensities, when there is one per beam, become the cloud's intensity.
+    pub fn to_cloud(&self) -> Result<PointCloud, AttributeError> {
+        let valid = |r: f32| r.is_finite() && r >= self.range_min && r <= self.range_max;
+        let pixels = self.ranges.iter().enumerate().map(|(i, &r)| {
+            let a = self.angle_min as f64 + i as f64 * self.angle_increment as f64;
+            valid(r).then(|| Point3::new(r as f64 * a.cos(), r as f64 * a.sin(), 0.0))
+        });
+        let mut cloud = PointCloud::from_pixels(self.ranges.len() as u32, 1, pixels)?;
+        if self.intensities.len() == self.ranges.len() {
+            let kept = self.ranges.iter().zip(&self.intensities).filter(|(r, _)| valid(**r));
+            cloud.set_intensity(Some(kept.map(|(_, &i)| i).collect()))?;
+        }
+        Ok(cloud)
+    }
+}
+
 /// A `geometry_msgs/TransformStamped`: `parent_from_child` at a time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransformStamped {
@@ -244,6 +364,14 @@ pub(crate) fn definition(type_name: &str, encoding: Encoding) -> Option<(String,
                 "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n",
             ),
             "94810edda583a504dfda3829e70d7eec",
+        ),
+        LASER_SCAN => (
+            concat!(
+                "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\n",
+                "float32 angle_increment\nfloat32 time_increment\nfloat32 scan_time\n",
+                "float32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities\n",
+            ),
+            "90c7ef2dc6895d81024acba2ac42f369",
         ),
         _ => return None,
     };

@@ -9,7 +9,7 @@ use pointcloud::{PointCloud, SensorPose};
 /// Which clouds [`read_scans`] takes and where it poses them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScanQuery {
-    /// The `sensor_msgs/PointCloud2` topic.
+    /// The `sensor_msgs/PointCloud2` or `sensor_msgs/LaserScan` topic.
     pub topic: String,
     /// The frame the scans are posed in (`odom`, `map`); `None`: the root of the first cloud's
     /// transform chain, or, without any transform to it, the sensor frame (no pose).

@@ -143,6 +143,11 @@ impl<'a> Reader<'a> {
         Ok(i32::from_le_bytes(self.fixed(field)?))
     }
 
+    /// A `float32`.
+    pub fn f32(&mut self, field: &str) -> Result<f32, WireError> {
+        Ok(f32::from_le_bytes(self.fixed(field)?))
+    }
+
     /// A `float64`.
     pub fn f64(&mut self, field: &str) -> Result<f64, WireError> {
         Ok(f64::from_le_bytes(self.fixed(field)?))
@@ -232,6 +237,12 @@ impl Writer {
 
     /// An `int32`.
     pub fn i32(&mut self, v: i32) {
+        self.align(4);
+        self.out.extend(v.to_le_bytes());
+    }
+
+    /// A `float32`.
+    pub fn f32(&mut self, v: f32) {
         self.align(4);
         self.out.extend(v.to_le_bytes());
     }

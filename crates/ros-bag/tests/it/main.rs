@@ -2,5 +2,6 @@
 
 mod fixture;
 mod hostile;
+mod laser_scan;
 mod official_reader;
 mod round_trip;
