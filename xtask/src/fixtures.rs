@@ -8,18 +8,22 @@
 //! | `lab-tof-depth_intrinsics.json` | its pinhole intrinsics (the sidecar `pointcloud::io::read_cloud` looks for) |
 //! | `terrain-ramp-stereo.bin` | a 15° ramp seen by the stereo camera (every fourth row and column), KITTI-style float32 records (unorganised, camera optical frame) |
 //! | `lab-alrf-2deg.3d`, `lab-alrf-2deg.pose` | the ALRF scan in 3DTK's format (cm, left-handed) with its pose |
+//! | `lab-alrf.mcap`, `lab-alrf.bag` | a ROS 2 MCAP bag and a ROS 1 bag of three ALRF scans (6° steps) from a moving base: `/tf_static` (base_link → laser), `/tf` (odom → base_link, 100 ms before, at and after each scan), `/points` (organised, float32) and `/points_flat` (the same scans unorganised, float64 in a padded layout) |
 //!
 //! Tests read these files, and `fixtures_are_current` regenerates them and compares bytes, so a
 //! change to a writer or to the simulator shows up as a stale fixture.
 
 use anyhow::{Context, Result};
-use pointcloud::PointCloud;
 use pointcloud::io::Precision;
 use pointcloud::io::depth_png::write_depth_png;
 use pointcloud::io::kitti::write_kitti_bin;
 use pointcloud::io::pcd::{PcdEncoding, PcdWriteOptions, write_pcd};
 use pointcloud::io::ply::{PlyEncoding, PlyWriteOptions, write_ply};
+use pointcloud::io::pointcloud2::{Pc2Layout, encode};
 use pointcloud::io::uos::{write_uos_pose, write_uos_scan};
+use pointcloud::{Isometry3, PointCloud};
+use ros_bag::msgs::{POINT_CLOUD2, TF_MESSAGE};
+use ros_bag::{BagFormat, BagWriter, Header, TransformStamped};
 use scene_sim::{Alrf, AlrfConfig, RangeCamera, RangeSensor, StereoCamera, scene_by_name};
 use std::path::Path;
 
@@ -76,7 +80,11 @@ pub fn generate() -> Result<Vec<Fixture>> {
     let mut bin = Vec::new();
     write_kitti_bin(&mut bin, &stereo_cloud)?;
 
+    let (mcap, bag) = (lab_bag(&lab, BagFormat::Mcap)?, lab_bag(&lab, BagFormat::Ros1)?);
+
     Ok(vec![
+        ("lab-alrf.mcap", mcap),
+        ("lab-alrf.bag", bag),
         ("lab-alrf-2deg.ply", ply),
         ("lab-alrf-2deg.3d", uos),
         ("lab-alrf-2deg.pose", uos_pose),
@@ -85,6 +93,50 @@ pub fn generate() -> Result<Vec<Fixture>> {
         ("lab-tof-depth_intrinsics.json", json),
         ("terrain-ramp-stereo.bin", bin),
     ])
+}
+
+/// Three ALRF scans of `lab` from a moving base as a bag (see the module docs).
+fn lab_bag(lab: &scene_sim::Scene, format: BagFormat) -> Result<Vec<u8>> {
+    let stamped = |stamp_ns, parent: &str, child: &str, m| TransformStamped {
+        header: Header { stamp_ns, frame_id: parent.into() },
+        child_frame_id: child.into(),
+        parent_from_child: m,
+    };
+    let alrf = Alrf::new(AlrfConfig::sick_s300_with_step(6f64.to_radians())?)?;
+    let base_from_laser = Isometry3::translation(0.1, 0.0, 0.5);
+    let t0 = 1_700_000_000_000_000_000i64;
+    let mut w = BagWriter::new(format)?;
+    let tf_static = w.add_topic("/tf_static", TF_MESSAGE)?;
+    let tf = w.add_topic("/tf", TF_MESSAGE)?;
+    let points = w.add_topic("/points", POINT_CLOUD2)?;
+    let flat = w.add_topic("/points_flat", POINT_CLOUD2)?;
+    w.write_tf(tf_static, t0 as u64, &[stamped(t0, "base_link", "laser", base_from_laser)])?;
+    let padded = Pc2Layout {
+        precision: Precision::F64,
+        padding: 4,
+        row_padding: 0,
+        big_endian: false,
+        positions_last: false,
+    };
+    for (k, body) in lab.scan_poses(3, SENSOR_HEIGHT, SEED).into_iter().enumerate() {
+        let laser = alrf.mount(&body);
+        let mut cloud = alrf.scan(lab, &laser, SEED + k as u64).to_cloud()?;
+        cloud.set_sensor_pose(None);
+        let odom_from_base = laser.world_from_sensor * base_from_laser.inverse();
+        let stamp = t0 + 100_000_000 + k as i64 * 500_000_000;
+        for dt in [-100_000_000i64, 0, 100_000_000] {
+            let creep = Isometry3::translation(dt as f64 * 0.3e-9, 0.0, 0.0);
+            let m = odom_from_base * creep;
+            w.write_tf(tf, (stamp + dt) as u64, &[stamped(stamp + dt, "odom", "base_link", m)])?;
+            if dt == 0 {
+                let header = Header { stamp_ns: stamp, frame_id: "laser".into() };
+                w.write_cloud(points, &header, &encode(&cloud, &Pc2Layout::default())?)?;
+                cloud.set_grid(None)?;
+                w.write_cloud(flat, &header, &encode(&cloud, &padded)?)?;
+            }
+        }
+    }
+    Ok(w.finish()?)
 }
 
 /// The points of every fourth row and column of an organised cloud (a small fixture).
@@ -131,7 +183,11 @@ mod tests {
     fn load_all(dir: &Path) -> Result<Vec<(&'static str, PointCloud)>> {
         let mut out = Vec::new();
         for (name, _) in generate()? {
-            if name.ends_with(".json") || name.ends_with(".pose") {
+            if name.ends_with(".json")
+                || name.ends_with(".pose")
+                || name.ends_with(".mcap")
+                || name.ends_with(".bag")
+            {
                 continue;
             }
             let cloud = io::read_cloud(&dir.join(name), &io::ReadOptions::STRICT)?;
@@ -173,5 +229,24 @@ mod tests {
             .map(|(a, b)| (a - b).norm())
             .fold(0.0, f64::max);
         assert!(max_err < 1e-4, "3DTK copy differs by {max_err} m");
+    }
+
+    #[test]
+    fn bag_fixtures_hold_three_posed_scans() {
+        let dir = crate::project_root().join("fixtures");
+        for name in ["lab-alrf.mcap", "lab-alrf.bag"] {
+            let bag = ros_bag::Bag::open(dir.join(name)).unwrap();
+            let found = ros_bag::read_scans(&bag, &ros_bag::ScanQuery::all("/points")).unwrap();
+            assert_eq!(found.counts, (3, 3, 3), "{name}");
+            assert_eq!(found.fixed_frame.as_deref(), Some("odom"));
+            for s in &found.scans {
+                assert!(s.cloud.grid().is_some() && s.cloud.len() > 500, "{name}");
+            }
+            let flat = ros_bag::read_scans(&bag, &ros_bag::ScanQuery::all("/points_flat")).unwrap();
+            for (a, b) in found.scans.iter().zip(&flat.scans) {
+                assert!(b.cloud.grid().is_none());
+                assert_eq!(a.cloud.len(), b.cloud.len());
+            }
+        }
     }
 }

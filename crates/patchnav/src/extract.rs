@@ -3,6 +3,11 @@
 //! for the non-planar remainder) from range scans, merged across scans, written as a map file
 //! of any patch backend (thesis §5.3, §6.1; `patch_extract::pipeline`).
 //!
+//! `patchnav extract BAG --topic T [--fixed-frame F] [--every N | --min-motion M] [--start S]
+//! [--end S]` takes the scans from the `sensor_msgs/PointCloud2` messages of a ROS bag (`.mcap`,
+//! rosbag2 folder, ROS 1 `.bag`), each posed by the bag's `/tf` and `/tf_static` at its stamp
+//! (`ros_bag::read_scans`).
+//!
 //! Each scan is read in its sensor frame with its pose: PLY files written by `patchnav
 //! simulate` carry it, PCD files have `VIEWPOINT`, 3DTK `.3d` scans the sibling `.pose` file.
 //! `--poses FILE` overrides them with the `poses.json` layout `patchnav simulate` writes
@@ -42,9 +47,28 @@ use std::path::{Path, PathBuf};
 /// Arguments of `patchnav extract`.
 #[derive(Args, Debug)]
 pub struct ExtractArgs {
-    /// Scans in their sensor frame with their pose (.ply .pcd .3d .bin .xyz .png).
+    /// Scans in their sensor frame with their pose (.ply .pcd .3d .bin .xyz .png), or one ROS
+    /// bag (.mcap, a rosbag2 folder, .bag) with --topic.
     #[arg(required = true)]
     pub scans: Vec<PathBuf>,
+    /// The bag's `sensor_msgs/PointCloud2` or `sensor_msgs/LaserScan` topic to take scans from.
+    #[arg(long)]
+    pub topic: Option<String>,
+    /// The frame bag scans are posed in (default: the root of the clouds' transform chain).
+    #[arg(long, requires = "topic")]
+    pub fixed_frame: Option<String>,
+    /// Take every N-th cloud of the bag's time window.
+    #[arg(long, requires = "topic", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub every: u64,
+    /// Take a bag cloud only when the sensor moved at least M metres since the last one taken.
+    #[arg(long, requires = "topic", conflicts_with = "every")]
+    pub min_motion: Option<f64>,
+    /// Bag clouds from this many seconds after the bag's first message.
+    #[arg(long, requires = "topic")]
+    pub start: Option<f64>,
+    /// Bag clouds up to this many seconds after the bag's first message.
+    #[arg(long, requires = "topic")]
+    pub end: Option<f64>,
     /// The map file to write.
     #[arg(long, required_unless_present_any = ["export", "jsonl", "polygons"])]
     pub out: Option<PathBuf>,
@@ -116,7 +140,58 @@ fn config(args: &ExtractArgs) -> PipelineConfig {
     config
 }
 
-fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<Vec<PointCloud>> {
+/// Whether `path` names a ROS bag: a folder (rosbag2), `.mcap`, `.bag` or `.db3`.
+pub fn is_bag(path: &Path) -> bool {
+    path.is_dir()
+        || matches!(path.extension().and_then(|e| e.to_str()), Some("mcap" | "bag" | "db3"))
+}
+
+/// The scans of `--topic` in the bag, posed by its transforms, and one name per scan.
+fn read_bag_scans(
+    args: &ExtractArgs,
+    bag: &Path,
+    progress: &Progress,
+) -> Result<(Vec<PointCloud>, Vec<String>)> {
+    let Some(topic) = &args.topic else {
+        bail!("{}: a bag needs --topic (`patchnav info` lists its topics)", bag.display());
+    };
+    if args.poses.is_some() {
+        bail!("--poses is for scan files; a bag's scans are posed by its /tf");
+    }
+    let query = ros_bag::ScanQuery {
+        topic: topic.clone(),
+        fixed_frame: args.fixed_frame.clone(),
+        every: args.every as usize,
+        min_motion: args.min_motion,
+        start_s: args.start,
+        end_s: args.end,
+    };
+    let spinner = progress.spinner("reading the bag");
+    let found = ros_bag::read_scans(&ros_bag::Bag::open(bag)?, &query)?;
+    spinner.finish_and_clear();
+    for w in &found.warnings {
+        eprintln!("warning: {w}");
+    }
+    let (on_topic, in_window, kept) = found.counts;
+    let frame = found.fixed_frame.as_deref().unwrap_or("the sensor frame");
+    progress.say(format!(
+        "{}: {kept} of {on_topic} clouds on {topic} ({in_window} in the time window), posed in {frame}",
+        bag.display()
+    ));
+    let names = found.scans.iter().map(|s| format!("{topic} at {:.3} s", s.time_s)).collect();
+    Ok((found.scans.into_iter().map(|s| s.cloud).collect(), names))
+}
+
+fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<(Vec<PointCloud>, Vec<String>)> {
+    if let [bag] = &args.scans[..]
+        && is_bag(bag)
+    {
+        return read_bag_scans(args, bag, progress);
+    }
+    if args.topic.is_some() {
+        bail!("--topic takes one ROS bag (.mcap, a rosbag2 folder, .bag)");
+    }
+    let names = args.scans.iter().map(|p| p.display().to_string()).collect();
     let poses = args.poses.as_deref().map(read_poses).transpose()?;
     let bar = progress.bar(args.scans.len() as u64, "reading");
     let mut scans = Vec::with_capacity(args.scans.len());
@@ -134,7 +209,7 @@ fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<Vec<PointCloud>
         bar.inc(1);
     }
     bar.finish_and_clear();
-    Ok(scans)
+    Ok((scans, names))
 }
 
 /// The patches as one OBJ or PLY mesh (planar patches triangulated).
@@ -162,7 +237,7 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     {
         bail!("--export writes OBJ or PLY meshes; give a file ending in .obj or .ply");
     }
-    let scans = read_scans(args, progress)?;
+    let (scans, names) = read_scans(args, progress)?;
     let rss_after_load = peak_rss_kib();
     let config = config(args);
     let bar = progress.bar(scans.len() as u64, "extracting");
@@ -170,12 +245,12 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     bar.finish_and_clear();
 
     let mut out = String::new();
-    for (path, r) in args.scans.iter().zip(&result.scans) {
+    for (name, r) in names.iter().zip(&result.scans) {
         writeln!(
             out,
             "{}: {} points, {} planes ({} of them from the second pass; {} points), {} planar \
              patches, {} failed, {} remainder points, {} trimesh patches; outline vertices {} -> {}",
-            path.display(),
+            name,
             r.points,
             r.regions,
             r.second_pass_regions,
@@ -411,6 +486,12 @@ mod tests {
         let polygons = dir.path().join("wall.polygons.json");
         let args = ExtractArgs {
             scans: vec![scan],
+            topic: None,
+            fixed_frame: None,
+            every: 1,
+            min_motion: None,
+            start: None,
+            end: None,
             out: None,
             backend: Backend::BBox6d,
             spacing: None,

@@ -1,9 +1,10 @@
-//! `patchnav info FILE`.
+//! `patchnav info FILE|BAG`.
 
 use crate::input::InputArgs;
 use anyhow::Result;
 use pointcloud::io::{self, Format};
 use pointcloud::{Aabb, PointCloud};
+use ros_bag::{Bag, BagInfo};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -15,6 +16,9 @@ pub fn run(file: &Path, input: &InputArgs) -> Result<()> {
 
 /// The text `info` prints for `file`.
 pub fn describe(file: &Path, input: &InputArgs) -> Result<String> {
+    if crate::extract::is_bag(file) {
+        return describe_bag(file);
+    }
     let format = Format::from_path(file)
         .ok_or_else(|| anyhow::anyhow!("{}: unknown file extension", file.display()))?;
     let mut out = String::new();
@@ -29,6 +33,49 @@ pub fn describe(file: &Path, input: &InputArgs) -> Result<String> {
     }
     let cloud = crate::input::read_cloud(file, input)?;
     describe_cloud(&mut out, &cloud)?;
+    Ok(out)
+}
+
+/// Seconds since the epoch, to the millisecond.
+fn seconds(ns: u64) -> String {
+    format!("{}.{:03}", ns / 1_000_000_000, ns % 1_000_000_000 / 1_000_000)
+}
+
+/// The text `info` prints for a bag: its topics, types, counts, time span and frames.
+fn describe_bag(path: &Path) -> Result<String> {
+    let bag = Bag::open(path)?;
+    let info = BagInfo::of(&bag)?;
+    let mut out = String::new();
+    writeln!(out, "bag:        {}", path.display())?;
+    writeln!(out, "format:     {}", bag.format().name())?;
+    if bag.files().len() > 1 {
+        writeln!(out, "files:      {}", bag.files().len())?;
+    }
+    writeln!(out, "messages:   {}", info.messages)?;
+    if info.messages > 0 {
+        let span = (info.end_ns - info.start_ns) as f64 * 1e-9;
+        let (start, end) = (seconds(info.start_ns), seconds(info.end_ns));
+        writeln!(out, "time:       {start} .. {end} s ({span:.3} s)")?;
+    }
+    let join = |v: Vec<&str>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
+    writeln!(out, "frames:     {}", join(info.frames.iter().map(String::as_str).collect()))?;
+    let tf: Vec<String> = info.transforms.iter().map(|(p, c)| format!("{p} -> {c}")).collect();
+    writeln!(out, "transforms: {}", join(tf.iter().map(String::as_str).collect()))?;
+    writeln!(out, "topics:     {}", info.topics.len())?;
+    let width = info.topics.iter().map(|t| t.topic.len()).max().unwrap_or(0);
+    let type_width = info.topics.iter().map(|t| t.type_name.len()).max().unwrap_or(0);
+    for t in &info.topics {
+        let frames = join(t.frames.iter().map(String::as_str).collect());
+        writeln!(
+            out,
+            "  {:<width$}  {:<type_width$}  {:>6} msgs  {} .. {} s  frames {frames}",
+            t.topic,
+            t.type_name,
+            t.count,
+            seconds(t.first_ns),
+            seconds(t.last_ns),
+        )?;
+    }
     Ok(out)
 }
 

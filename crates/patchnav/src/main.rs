@@ -1,10 +1,10 @@
 //! `patchnav`: the command-line face of the workspace.
 //!
 //! ```text
-//! patchnav info FILE                      what a file holds
+//! patchnav info FILE|BAG                  what a file or a ROS bag holds
 //! patchnav convert IN OUT                 between PLY, PCD, OBJ, XYZ, KITTI .bin, 3DTK .3d
 //! patchnav simulate SCENE --sensor alrf|tof|stereo --poses N --out DIR
-//! patchnav extract SCANS... --out MAP [--sensor alrf|range-camera|structured-light|exact] [--hybrid] [--export F.obj|F.ply]
+//! patchnav extract SCANS...|BAG --out MAP [--topic T] [--sensor alrf|range-camera|structured-light|exact] [--hybrid] [--export F.obj|F.ply]
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
 //! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]
@@ -51,9 +51,11 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Print a file's format, point count, organised size, bounds and attributes.
+    /// Print a file's format, point count, organised size, bounds and attributes; or a ROS
+    /// bag's topics, types, message counts, time span and frames.
     Info {
-        /// A cloud, mesh or depth image (.ply .pcd .obj .xyz .txt .bin .3d .png).
+        /// A cloud, mesh or depth image (.ply .pcd .obj .xyz .txt .bin .3d .png), or a ROS bag
+        /// (.mcap, a rosbag2 folder, a ROS 1 .bag).
         file: PathBuf,
         #[command(flatten)]
         input: input::InputArgs,

@@ -13,8 +13,9 @@
 //! * [`Aabb`], [`Real`], [`Point3`], [`Vector3`], [`Isometry3`]: the math types of
 //!   `patch-math`, re-exported.
 //! * [`io`]: readers and writers for PLY, PCD v0.7, OBJ, XYZ, KITTI `.bin`, 3DTK `.3d`/`.pose`
-//!   and 16-bit PNG depth images. Every reader returns a typed [`io::Error`] that names the file
-//!   position on corrupt input; none panics.
+//!   and 16-bit PNG depth images, and the data layout of ROS `sensor_msgs/PointCloud2`
+//!   ([`io::pointcloud2`]). Every reader returns a typed error that names the file position or
+//!   the field on corrupt input; none panics.
 //!
 //! All geometry is `f64` and uses [`nalgebra`] types, re-exported as [`na`].
 //!

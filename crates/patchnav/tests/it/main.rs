@@ -1,5 +1,6 @@
 //! Integration tests of `patchnav`, one binary (`cargo test -p patchnav --test it`).
 
+mod bag;
 mod cli;
 mod common;
 mod demo;

@@ -9,6 +9,7 @@
 //! | KITTI / Ouster `.bin` | [`kitti`] | float32 `x y z i` | same | |
 //! | 3DTK `.3d` + `.pose` | [`uos`] | cm, left-handed → m, right-handed | same | |
 //! | 16-bit PNG depth | [`depth_png`] | with pinhole intrinsics and a depth scale | same | |
+//! | ROS `sensor_msgs/PointCloud2` data | [`pointcloud2`] | any field layout, float32/float64, either byte order, organised | same, in a chosen layout | a message's fields and bytes, no bag format |
 //!
 //! Every reader returns a typed [`Error`] naming the file position (line or byte offset) on
 //! corrupt input, truncation, a header that lies about the point count, or a non-finite value;
@@ -32,6 +33,7 @@ pub(crate) mod lzf;
 pub mod obj;
 pub mod pcd;
 pub mod ply;
+pub mod pointcloud2;
 pub mod uos;
 pub mod xyz;
 

@@ -7,6 +7,7 @@ mod kitti;
 mod obj;
 mod pcd;
 mod ply;
+mod pointcloud2;
 mod real_data;
 mod uos;
 mod xyz;

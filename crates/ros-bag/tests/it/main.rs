@@ -1,0 +1,7 @@
+//! Integration tests of `ros-bag`, one binary (`cargo test -p patchnav-ros-bag --test it`).
+
+mod fixture;
+mod hostile;
+mod laser_scan;
+mod official_reader;
+mod round_trip;
