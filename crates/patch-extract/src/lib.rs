@@ -67,7 +67,7 @@ pub use mixed_pixels::{
     MixedPixelConfig, MixedPixelFix, fix_mixed_pixels, mixed_pixels, remove_mixed_pixels,
     snap_mixed_pixels,
 };
-pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract};
+pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract, extract_with_threads};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
 pub use segment::{GrazingPlanes, SegmentConfig, segment, segment_remainder};

@@ -18,6 +18,8 @@
 //! should first drop the ±90° columns ([`crate::projection::invalidate_alrf_side_columns`],
 //! thesis App. A), which needs the scan's beam model and so is the caller's step.
 
+use std::num::NonZeroUsize;
+
 use crate::denoise::{BeamDenoiseConfig, DenoiseError, denoise_along_beams_where};
 use crate::fill::{FillError, fill_upward_holes};
 use crate::grid_mesh::RegionMask;
@@ -315,6 +317,16 @@ pub struct StageTimes {
 }
 
 impl StageTimes {
+    /// Adds `other`'s stages to these.
+    pub fn add(&mut self, other: &StageTimes) {
+        self.mixed_pixels += other.mixed_pixels;
+        self.segmentation += other.segmentation;
+        self.polygonization += other.polygonization;
+        self.trimesh += other.trimesh;
+        self.merging += other.merging;
+        self.carving += other.carving;
+    }
+
     /// The sum of the stages.
     pub fn total(&self) -> Duration {
         self.mixed_pixels
@@ -354,15 +366,33 @@ impl Extraction {
     }
 }
 
-/// Extracts the patches of `scans` (see the module docs); `progress` is called after each scan
-/// with its index.
+/// Extracts the patches of `scans` (see the module docs) on all cores: the scans are shared
+/// among [`std::thread::available_parallelism`] threads and their results joined in scan
+/// order, so the output equals [`extract_with_threads`]'s on one thread. `progress` is called
+/// with each scan's index, in order, once the scans before it are done too.
 ///
 /// # Errors
-/// [`ExtractError`] for refused parameters or a non-finite pose; never for the content of a
-/// scan (an empty scan gives no patches).
+/// [`ExtractError`] for refused parameters or a non-finite pose (the first scan's error, in
+/// scan order); never for the content of a scan (see [`ScanReport::failures`]).
 pub fn extract(
     scans: &[PointCloud],
     config: &PipelineConfig,
+    progress: impl FnMut(usize),
+) -> Result<Extraction, ExtractError> {
+    let threads = std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN);
+    extract_with_threads(scans, config, threads, progress)
+}
+
+/// [`extract`] on at most `threads` threads (one: no thread is started). The result does not
+/// depend on the count; [`StageTimes`] sum the stages over the scans, so with several threads
+/// they exceed the wall time.
+///
+/// # Errors
+/// As [`extract`].
+pub fn extract_with_threads(
+    scans: &[PointCloud],
+    config: &PipelineConfig,
+    threads: NonZeroUsize,
     mut progress: impl FnMut(usize),
 ) -> Result<Extraction, ExtractError> {
     let mut out = Extraction::default();
@@ -375,117 +405,56 @@ pub fn extract(
         }
         _ => None,
     };
+    let free_space = free_space.as_ref();
+    let threads = threads.get().min(scans.len());
+    let mut parts: Vec<Option<Result<ScanPart, ExtractError>>> = Vec::new();
+    parts.resize_with(scans.len(), || None);
+    let mut reported = 0;
+    let mut report_done = |parts: &[Option<Result<ScanPart, ExtractError>>]| {
+        while reported < parts.len() && parts[reported].is_some() {
+            progress(reported);
+            reported += 1;
+        }
+    };
+    if threads <= 1 {
+        for (index, scan) in scans.iter().enumerate() {
+            parts[index] = Some(extract_scan(index, scan, config, free_space));
+            report_done(&parts);
+        }
+    } else {
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::scope(|s| {
+            for _ in 0..threads {
+                let (next, sender) = (&next, sender.clone());
+                s.spawn(move || {
+                    loop {
+                        let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(scan) = scans.get(index) else { break };
+                        let part = extract_scan(index, scan, config, free_space);
+                        if sender.send((index, part)).is_err() {
+                            break;
+                        }
+                    }
+                });
+            }
+            drop(sender);
+            for (index, part) in receiver {
+                parts[index] = Some(part);
+                report_done(&parts);
+            }
+        });
+    }
     let mut planar: Vec<PlanarPatch> = Vec::new();
     let mut meshes: Vec<Patch> = Vec::new();
-    for (index, scan) in scans.iter().enumerate() {
-        let motion = match scan.sensor_pose() {
-            Some(pose) if !pose.is_finite() => return Err(ExtractError::BadPose { scan: index }),
-            Some(pose) => pose.world_from_sensor,
-            None => Isometry3::identity(),
-        };
-        let mut report = ScanReport { points: scan.len(), ..ScanReport::default() };
-        let filtered;
-        let scan = match (&config.mixed_pixels, scan.grid()) {
-            (Some(filter), Some(_)) => {
-                let t = Instant::now();
-                let (kept, removed) = remove_mixed_pixels(scan, filter)
-                    .map_err(|source| ExtractError::MixedPixels { scan: index, source })?;
-                out.times.mixed_pixels += t.elapsed();
-                report.mixed_pixels = removed;
-                filtered = kept;
-                &filtered
-            }
-            _ => scan,
-        };
-        let t = Instant::now();
-        let mut segmentation = segment(scan, &config.segment)
-            .map_err(|source| ExtractError::Segment { scan: index, source })?;
-        if let Some(second) = &config.second_pass {
-            report.second_pass_regions = segment_remainder(scan, &mut segmentation, second)
-                .map_err(|source| ExtractError::Segment { scan: index, source })?;
-        }
-        out.times.segmentation += t.elapsed();
-        report.regions = segmentation.regions.len();
-        report.region_points = segmentation.regions.iter().map(|r| r.points.len()).sum();
-        report.remainder_points = segmentation.remainder.len();
-
-        let t = Instant::now();
-        for region in &segmentation.regions {
-            match polygonize_region(scan, region, &config.polygonize) {
-                Ok(p) => {
-                    report.planar_patches += p.patches.len();
-                    report.outline_vertices.0 += p.vertices_before;
-                    report.outline_vertices.1 += p.vertices_after;
-                    planar.extend(p.patches.iter().map(|patch| patch.transformed(&motion)));
-                }
-                Err(e) => {
-                    report.failed_regions += 1;
-                    if report.failures.len() < 8 {
-                        report.failures.push(e.to_string());
-                    }
-                }
-            }
-        }
-        out.times.polygonization += t.elapsed();
-
-        if let Some(grow) = &config.remainder {
-            let t = Instant::now();
-            let mut scattered = Vec::new();
-            let grown = match (scan.grid(), &config.unorganised) {
-                (Some(grid), _) => {
-                    let mask = RegionMask::from_points(grid, &segmentation.remainder);
-                    let denoised;
-                    let scan = match &config.denoise {
-                        Some(d) => {
-                            let mut in_remainder = vec![false; scan.len()];
-                            for &i in &segmentation.remainder {
-                                in_remainder[i as usize] = true;
-                            }
-                            denoised = denoise_along_beams_where(scan, d, |i| in_remainder[i])
-                                .map_err(|source| ExtractError::Denoise { scan: index, source })?
-                                .0;
-                            &denoised
-                        }
-                        None => scan,
-                    };
-                    grow_trimeshes_in(scan, &mask, grow)
-                        .map_err(|source| ExtractError::Trimesh { scan: index, source })?
-                }
-                (None, Some(spherical)) => {
-                    let noise = config.segment.noise;
-                    let made = mesh_unorganised(
-                        scan.positions(),
-                        &segmentation.remainder,
-                        spherical,
-                        grow,
-                        &|r| noise.sigma(r),
-                    )
-                    .map_err(|source| ExtractError::SphericalGrid { scan: index, source })?;
-                    report.binned_remainder = made.binned;
-                    report.splats = made.splat_triangles;
-                    scattered = made.scattered;
-                    made.grown
-                }
-                (None, None) => GrownTrimeshes::default(),
-            };
-            report.trimesh_patches = grown.meshes.len();
-            let grown = grown.into_patches().into_iter().chain(scattered);
-            let grown = grown.map(|m| m.transformed(&motion));
-            out.times.trimesh += t.elapsed();
-            match &free_space {
-                Some(space) => {
-                    let t = Instant::now();
-                    let grown: Vec<_> = grown.collect();
-                    let (kept, carved) = space.carve_trimeshes(&grown, Some(index));
-                    report.carved = carved;
-                    meshes.extend(kept.into_iter().map(Patch::Trimesh));
-                    out.times.carving += t.elapsed();
-                }
-                None => meshes.extend(grown.map(Patch::Trimesh)),
-            }
-        }
-        out.scans.push(report);
-        progress(index);
+    for part in parts {
+        // Every index was taken by a worker, and each sent its part before it ended.
+        let Some(part) = part else { unreachable!("a scan without a result") };
+        let part = part?;
+        out.times.add(&part.times);
+        out.scans.push(part.report);
+        planar.extend(part.planar);
+        meshes.extend(part.meshes);
     }
     if let Some(merge) = &config.merge {
         let t = Instant::now();
@@ -502,4 +471,131 @@ pub fn extract(
     }
     out.patches = planar.into_iter().map(Patch::Planar).chain(meshes).collect();
     Ok(out)
+}
+
+/// What one scan gives: its report, its patches in the world frame, the time of its stages.
+struct ScanPart {
+    report: ScanReport,
+    planar: Vec<PlanarPatch>,
+    meshes: Vec<Patch>,
+    times: StageTimes,
+}
+
+/// The per-scan stages of [`extract`] on scan `index`.
+fn extract_scan(
+    index: usize,
+    scan: &PointCloud,
+    config: &PipelineConfig,
+    free_space: Option<&FreeSpace>,
+) -> Result<ScanPart, ExtractError> {
+    let mut times = StageTimes::default();
+    let mut planar: Vec<PlanarPatch> = Vec::new();
+    let mut meshes: Vec<Patch> = Vec::new();
+    let motion = match scan.sensor_pose() {
+        Some(pose) if !pose.is_finite() => return Err(ExtractError::BadPose { scan: index }),
+        Some(pose) => pose.world_from_sensor,
+        None => Isometry3::identity(),
+    };
+    let mut report = ScanReport { points: scan.len(), ..ScanReport::default() };
+    let filtered;
+    let scan = match (&config.mixed_pixels, scan.grid()) {
+        (Some(filter), Some(_)) => {
+            let t = Instant::now();
+            let (kept, removed) = remove_mixed_pixels(scan, filter)
+                .map_err(|source| ExtractError::MixedPixels { scan: index, source })?;
+            times.mixed_pixels += t.elapsed();
+            report.mixed_pixels = removed;
+            filtered = kept;
+            &filtered
+        }
+        _ => scan,
+    };
+    let t = Instant::now();
+    let mut segmentation = segment(scan, &config.segment)
+        .map_err(|source| ExtractError::Segment { scan: index, source })?;
+    if let Some(second) = &config.second_pass {
+        report.second_pass_regions = segment_remainder(scan, &mut segmentation, second)
+            .map_err(|source| ExtractError::Segment { scan: index, source })?;
+    }
+    times.segmentation += t.elapsed();
+    report.regions = segmentation.regions.len();
+    report.region_points = segmentation.regions.iter().map(|r| r.points.len()).sum();
+    report.remainder_points = segmentation.remainder.len();
+
+    let t = Instant::now();
+    for region in &segmentation.regions {
+        match polygonize_region(scan, region, &config.polygonize) {
+            Ok(p) => {
+                report.planar_patches += p.patches.len();
+                report.outline_vertices.0 += p.vertices_before;
+                report.outline_vertices.1 += p.vertices_after;
+                planar.extend(p.patches.iter().map(|patch| patch.transformed(&motion)));
+            }
+            Err(e) => {
+                report.failed_regions += 1;
+                if report.failures.len() < 8 {
+                    report.failures.push(e.to_string());
+                }
+            }
+        }
+    }
+    times.polygonization += t.elapsed();
+
+    if let Some(grow) = &config.remainder {
+        let t = Instant::now();
+        let mut scattered = Vec::new();
+        let grown = match (scan.grid(), &config.unorganised) {
+            (Some(grid), _) => {
+                let mask = RegionMask::from_points(grid, &segmentation.remainder);
+                let denoised;
+                let scan = match &config.denoise {
+                    Some(d) => {
+                        let mut in_remainder = vec![false; scan.len()];
+                        for &i in &segmentation.remainder {
+                            in_remainder[i as usize] = true;
+                        }
+                        denoised = denoise_along_beams_where(scan, d, |i| in_remainder[i])
+                            .map_err(|source| ExtractError::Denoise { scan: index, source })?
+                            .0;
+                        &denoised
+                    }
+                    None => scan,
+                };
+                grow_trimeshes_in(scan, &mask, grow)
+                    .map_err(|source| ExtractError::Trimesh { scan: index, source })?
+            }
+            (None, Some(spherical)) => {
+                let noise = config.segment.noise;
+                let made = mesh_unorganised(
+                    scan.positions(),
+                    &segmentation.remainder,
+                    spherical,
+                    grow,
+                    &|r| noise.sigma(r),
+                )
+                .map_err(|source| ExtractError::SphericalGrid { scan: index, source })?;
+                report.binned_remainder = made.binned;
+                report.splats = made.splat_triangles;
+                scattered = made.scattered;
+                made.grown
+            }
+            (None, None) => GrownTrimeshes::default(),
+        };
+        report.trimesh_patches = grown.meshes.len();
+        let grown = grown.into_patches().into_iter().chain(scattered);
+        let grown = grown.map(|m| m.transformed(&motion));
+        times.trimesh += t.elapsed();
+        match &free_space {
+            Some(space) => {
+                let t = Instant::now();
+                let grown: Vec<_> = grown.collect();
+                let (kept, carved) = space.carve_trimeshes(&grown, Some(index));
+                report.carved = carved;
+                meshes.extend(kept.into_iter().map(Patch::Trimesh));
+                times.carving += t.elapsed();
+            }
+            None => meshes.extend(grown.map(Patch::Trimesh)),
+        }
+    }
+    Ok(ScanPart { report, planar, meshes, times })
 }

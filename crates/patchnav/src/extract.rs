@@ -34,7 +34,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::triangulate::patch_triangles;
 use patch_core::{Patch, Point3};
-use patch_extract::pipeline::{PipelineConfig, extract};
+use patch_extract::pipeline::{PipelineConfig, extract_with_threads};
 use patch_extract::visibility::{Carved, VisibilityConfig};
 use patch_map::Backend;
 pub use patch_pipeline::SensorPreset;
@@ -42,6 +42,7 @@ use patch_pipeline::files::{read_poses, save_patches};
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
+use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `patchnav extract`.
@@ -106,6 +107,9 @@ pub struct ExtractArgs {
     /// A poses JSON overriding the scans' own poses.
     #[arg(long)]
     pub poses: Option<PathBuf>,
+    /// Scans extracted at once (default: one per core; the result does not depend on it).
+    #[arg(long)]
+    pub threads: Option<NonZeroUsize>,
     /// Also write the patches, triangulated, as a mesh for any 3D viewer (`.obj`, or `.ply`:
     /// binary PLY).
     #[arg(long)]
@@ -241,7 +245,10 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     let rss_after_load = peak_rss_kib();
     let config = config(args);
     let bar = progress.bar(scans.len() as u64, "extracting");
-    let result = extract(&scans, &config, |_| bar.inc(1))?;
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN));
+    let result = extract_with_threads(&scans, &config, threads, |_| bar.inc(1))?;
     bar.finish_and_clear();
 
     let mut out = String::new();
@@ -502,6 +509,7 @@ mod tests {
             carve: false,
             slab_thickness: None,
             poses: None,
+            threads: None,
             export: None,
             jsonl: Some(jsonl.clone()),
             polygons: Some(polygons.clone()),

@@ -1,7 +1,7 @@
 //! The whole pipeline on simulated range-camera frames of one room corner from two poses.
 
 use patch_core::{Patch, PlanarPatch, Point3, Real, Vector3};
-use patch_extract::pipeline::{ExtractError, PipelineConfig, extract};
+use patch_extract::pipeline::{ExtractError, PipelineConfig, extract, extract_with_threads};
 use patch_extract::trimesh_grow::TrimeshGrowConfig;
 use pointcloud::{PointCloud, SensorPose};
 use scene_sim::{
@@ -168,6 +168,32 @@ fn hybrid_maps_of_unorganised_scans_mesh_the_remainder_too() {
     }
     let err = extract(&scans, &bad, |_| {}).unwrap_err();
     assert!(matches!(err, ExtractError::SphericalGrid { scan: 0, .. }), "{err}");
+}
+
+/// The scans shared among threads give what one thread gives, and progress comes in scan
+/// order.
+#[test]
+fn any_thread_count_gives_the_same_extraction() {
+    let mut scans = scans();
+    scans.extend(scans.clone());
+    let config = PipelineConfig::range_camera().with_remainder(TrimeshGrowConfig::range_camera());
+    let run = |threads: usize| {
+        let mut seen = Vec::new();
+        let threads = std::num::NonZeroUsize::new(threads).unwrap();
+        let out = extract_with_threads(&scans, &config, threads, |i| seen.push(i)).unwrap();
+        assert_eq!(seen, (0..scans.len()).collect::<Vec<_>>(), "{threads} threads");
+        out
+    };
+    let one = run(1);
+    assert!(!one.patches.is_empty());
+    for threads in [2, 3, 8] {
+        let many = run(threads);
+        assert_eq!(many.patches, one.patches, "{threads} threads");
+        assert_eq!(many.back_faces, one.back_faces);
+        assert_eq!(many.scans, one.scans);
+        assert_eq!(format!("{:?}", many.merge), format!("{:?}", one.merge));
+        assert_eq!(many.filled_holes, one.filled_holes);
+    }
 }
 
 #[test]
