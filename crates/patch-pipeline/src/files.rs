@@ -40,22 +40,33 @@ pub fn read_poses(path: &Path) -> Result<HashMap<String, Isometry3>> {
             .flat_map(|r| r.as_array().into_iter().flatten())
             .map(|x| x.as_f64().unwrap_or(Real::NAN))
             .collect();
-        if m.len() != 16 || !m.iter().all(|x| x.is_finite()) {
-            bail!("{}: `world_from_sensor` is not 4 rows of 4 finite numbers", what());
-        }
-        let m = na::Matrix4::from_row_slice(&m);
-        let r = m.fixed_view::<3, 3>(0, 0).into_owned();
-        if (r.transpose() * r - na::Matrix3::identity()).norm() > 1e-6
-            || r.determinant() < 0.0
-            || m.row(3).transpose() != na::Vector4::new(0.0, 0.0, 0.0, 1.0)
-        {
-            bail!("{}: `world_from_sensor` is not a rigid transform", what());
-        }
-        let rotation = na::UnitQuaternion::from_matrix(&r);
-        let translation = na::Translation3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]);
-        out.insert(file.to_owned(), Isometry3::from_parts(translation, rotation));
+        let pose =
+            rigid_from_rows(&m).with_context(|| format!("{}: `world_from_sensor`", what()))?;
+        out.insert(file.to_owned(), pose);
     }
     Ok(out)
+}
+
+/// A rigid transform from the 16 entries of a 4 × 4 matrix, row by row.
+///
+/// # Errors
+/// Not 16 finite numbers, or not a rotation (orthonormal to 1e-6, determinant +1) and a
+/// translation over the row `0 0 0 1`.
+pub fn rigid_from_rows(m: &[Real]) -> Result<Isometry3> {
+    if m.len() != 16 || !m.iter().all(|x| x.is_finite()) {
+        bail!("not 4 rows of 4 finite numbers");
+    }
+    let m = na::Matrix4::from_row_slice(m);
+    let r = m.fixed_view::<3, 3>(0, 0).into_owned();
+    if (r.transpose() * r - na::Matrix3::identity()).norm() > 1e-6
+        || r.determinant() < 0.0
+        || m.row(3).transpose() != na::Vector4::new(0.0, 0.0, 0.0, 1.0)
+    {
+        bail!("not a rigid transform");
+    }
+    let rotation = na::UnitQuaternion::from_matrix(&r);
+    let translation = na::Translation3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]);
+    Ok(Isometry3::from_parts(translation, rotation))
 }
 
 /// Reads a map file of any backend.
@@ -89,13 +100,25 @@ pub fn save_patches(
     spacing: Option<f64>,
     out: &Path,
 ) -> Result<(u64, usize)> {
-    let map = match AnyMap::from_patches(backend, patches, spacing) {
+    save_map(&map_of_patches(patches, backend, spacing)?, out)
+}
+
+/// A map of `backend` holding `patches` (`spacing`: the sample spacing of a point-cloud map
+/// made from patches, which it needs).
+///
+/// # Errors
+/// A patch the backend cannot hold, or no spacing for a point-cloud map.
+pub fn map_of_patches(
+    patches: Vec<Patch>,
+    backend: Backend,
+    spacing: Option<f64>,
+) -> Result<AnyMap> {
+    match AnyMap::from_patches(backend, patches, spacing) {
         Err(AnyMapError::NeedsSpacing) => {
             bail!("the pointcloud backend needs a point cloud, or --spacing to sample the patches")
         }
-        map => map?,
-    };
-    save_map(&map, out)
+        map => Ok(map?),
+    }
 }
 
 /// A box as `(x, y, z)..(x, y, z)` in centimetres' precision, for messages.

@@ -47,6 +47,7 @@ pub mod experiment;
 pub mod files;
 pub mod input;
 pub mod names;
+pub mod plan;
 pub mod polylines;
 pub mod preset;
 pub mod problem;

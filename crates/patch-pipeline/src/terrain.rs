@@ -19,7 +19,7 @@ use hough_terrain::{
     Classification, HistogramStyle, HoughClassifier, HoughConfig, MountEstimate, MountSearch,
     SectorClassifier, SectorGrid, SensorAxes, SensorMount, estimate_mount, hough_png_file,
 };
-use pointcloud::Point3;
+use pointcloud::{Point3, PointCloud};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -115,6 +115,13 @@ pub struct Classified {
 /// A parameter out of range, an unreadable or empty frame, no point ahead, or a classifier
 /// refusing its input.
 pub fn classify(args: &TerrainSetup) -> Result<Classified> {
+    check(args)?;
+    let cloud = input::read_cloud(&args.frame, &args.input)?;
+    classify_checked(&cloud, args)
+}
+
+/// Checks the parameters of a [`TerrainSetup`].
+fn check(args: &TerrainSetup) -> Result<()> {
     ensure!(
         args.resolution.is_finite() && args.resolution > 0.0 && args.resolution <= 90.0,
         "--resolution must be in (0, 90] degrees, not {}",
@@ -139,16 +146,28 @@ pub fn classify(args: &TerrainSetup) -> Result<Classified> {
         ensure!((1..=90).contains(&n), "--sectors must be in 1..=90, not {n}");
     }
     ensure!((1..=100_000).contains(&args.repeat), "--repeat must be in 1..=100000");
+    Ok(())
+}
 
-    let cloud = input::read_cloud(&args.frame, &args.input)?;
+/// [`classify`] on a cloud in memory (from a bag, or the Python package's arrays): `args.frame`
+/// only names the frame in messages, `args.input` is not used.
+///
+/// # Errors
+/// As [`classify`], but for reading.
+pub fn classify_cloud(cloud: &PointCloud, args: &TerrainSetup) -> Result<Classified> {
+    check(args)?;
+    classify_checked(cloud, args)
+}
+
+fn classify_checked(cloud: &PointCloud, args: &TerrainSetup) -> Result<Classified> {
     ensure!(!cloud.is_empty(), "{}: the frame has no points", args.frame.display());
     let organised = cloud.grid().is_some();
-    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(&cloud));
+    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(cloud));
     let sensor_axes = axes.sensor_axes();
     let (height, pitch, roll, estimated) = match args.sensor_height {
         Some(h) => (h, args.pitch.unwrap_or(0.0).to_radians(), 0.0, None),
         None => {
-            let e = frame_mount(&cloud, sensor_axes, &args.frame)?;
+            let e = frame_mount(cloud, sensor_axes, &args.frame)?;
             (e.height, args.pitch.map_or(e.pitch, f64::to_radians), e.roll, Some(e))
         }
     };

@@ -124,26 +124,43 @@ pub fn load_frame(args: &FrameSource, cloud: Option<&Path>) -> Result<(TofFrame,
 /// range, or the filter refusing the frame.
 pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, String)> {
     let (frame, meta) = load_frame(&args.frame, args.cloud.as_deref())?;
+    let (output, name) = filter_loaded(&frame, &meta, args)?;
+    Ok((frame, output, name))
+}
+
+/// Filters a frame in memory (the Python package's arrays) as `--method` says: the filter's
+/// output and the method's name. `args.frame.meta` names the sidecar in messages; the frame's
+/// other paths and `args.cloud` are not read (two-frequency unwrapping reads its second frame
+/// from `--range2`, `--amplitude2` and `--meta2`).
+///
+/// # Errors
+/// No AAT parameters for `--method aat`, a parameter out of range, or the filter refusing the
+/// frame.
+pub fn filter_loaded(
+    frame: &TofFrame,
+    meta: &FrameMeta,
+    args: &FilterSetup,
+) -> Result<(FilterOutput, String)> {
     let (output, name) = match args.method {
         Method::At => {
             if args.unwrap {
                 bail!("--unwrap needs --method aat: a plain AT flags dark pixels at any range");
             }
             let f = TofFilter::new(frame.camera(), frame.kind(), &FilterConfig::at(args.at))?;
-            (f.run(&frame)?, format!("AT {}", args.at))
+            (f.run(frame)?, format!("AT {}", args.at))
         }
         Method::Aat => {
             if args.low_at.is_some() && !args.unwrap {
                 bail!("--low-at needs --unwrap with --method aat (or --method regions)");
             }
-            let aat = aat_of(args, &frame, &meta)?;
+            let aat = aat_of(args, frame, meta)?;
             let name = format!("AAT {}", aat.threshold);
             let config = if args.unwrap {
                 FilterConfig::aat_unwrap(aat, args.low_at)
             } else {
                 FilterConfig::aat(aat)
             };
-            (TofFilter::new(frame.camera(), frame.kind(), &config)?.run(&frame)?, name)
+            (TofFilter::new(frame.camera(), frame.kind(), &config)?.run(frame)?, name)
         }
         Method::Regions => {
             if args.unwrap {
@@ -151,10 +168,10 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
                     "--unwrap is for --method aat: --method regions decides what to unwrap itself"
                 );
             }
-            let aat = aat_of(args, &frame, &meta)?;
+            let aat = aat_of(args, frame, meta)?;
             let name = format!("regions (AAT {})", aat.threshold);
             let config = RegionConfig { low_at: args.low_at, ..RegionConfig::new(aat) };
-            let out = RegionUnwrapper::new(frame.camera(), frame.kind(), &config)?.run(&frame)?;
+            let out = RegionUnwrapper::new(frame.camera(), frame.kind(), &config)?.run(frame)?;
             (out, name)
         }
         Method::TwoFreq => {
@@ -172,7 +189,7 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
             )?;
             config.min_amplitude = args.min_amplitude;
             let mut out = FilterOutput::default();
-            unwrap_two_frequencies(&frame, &frame2, &config, &mut out)?;
+            unwrap_two_frequencies(frame, &frame2, &config, &mut out)?;
             let name = format!(
                 "two-frequency {} + {} MHz",
                 meta.modulation_hz / 1e6,
@@ -181,7 +198,7 @@ pub fn filter_frame(args: &FilterSetup) -> Result<(TofFrame, FilterOutput, Strin
             (out, name)
         }
     };
-    Ok((frame, output, name))
+    Ok((output, name))
 }
 
 /// The AAT of `--method aat` and `--method regions`: the calibration's illumination or the

@@ -35,10 +35,11 @@ use clap::Args;
 use patch_core::triangulate::patch_triangles;
 use patch_core::{Patch, Point3};
 use patch_extract::pipeline::{PipelineConfig, extract_with_threads};
-use patch_extract::visibility::{Carved, VisibilityConfig};
+use patch_extract::visibility::Carved;
 use patch_map::Backend;
 pub use patch_pipeline::SensorPreset;
 use patch_pipeline::files::{read_poses, save_patches};
+use patch_pipeline::preset::ExtractChoices;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -125,23 +126,15 @@ pub struct ExtractArgs {
 }
 
 fn config(args: &ExtractArgs) -> PipelineConfig {
-    let (mut config, grow) = args.sensor.configs();
-    if args.hybrid {
-        config.remainder = Some(grow);
+    ExtractChoices {
+        sensor: args.sensor,
+        hybrid: args.hybrid,
+        merge: !args.no_merge,
+        second_pass: !args.no_second_pass,
+        carve: args.carve,
+        slab_thickness: args.slab_thickness,
     }
-    if args.no_merge {
-        config.merge = None;
-    }
-    if args.no_second_pass {
-        config.second_pass = None;
-    }
-    if args.carve {
-        config.carve = Some(VisibilityConfig::alrf());
-    }
-    if let Some(t) = args.slab_thickness {
-        config.slab_thickness = (t != 0.0).then_some(t);
-    }
-    config
+    .config()
 }
 
 /// Whether `path` names a ROS bag: a folder (rosbag2), `.mcap`, `.bag` or `.db3`.

@@ -7,12 +7,9 @@ use crate::progress::Progress;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use patch_core::{Point3, Real};
-use patch_map::AnyMap;
+use patch_pipeline::plan::{PlanSetup, plan_on_map};
 use patch_pipeline::polylines::{write_obj_lines, write_obj_roadmap};
-use roadmap::{
-    AnyOf, Goal, GoalReached, MaxIterations, PathMetrics, Planner, PlannerKind, PlanningSpace,
-    Problem, ShortcutConfig, named_planner_on, shortcut_path,
-};
+use roadmap::{PathMetrics, PlannerKind};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -85,32 +82,26 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
         bail!("give a MAP with --start, --goal and --radius, or --problem");
     };
     let map = patch_pipeline::files::open_map(map_path)?;
-    let bounds = map.bounds();
-    if bounds.is_empty() {
-        bail!("{}: the map is empty, so it has no bounds to sample in", map_path.display());
-    }
-    let space = PlanningSpace::new(bounds, radius, args.step)
-        .context("--radius and --step must be positive numbers of metres")?;
-    let problem = Problem {
+    let setup = PlanSetup {
         start,
-        goals: args
-            .goals
-            .iter()
-            .map(|&center| Goal { center, tolerance: args.goal_tolerance })
-            .collect(),
+        goals: args.goals.clone(),
+        goal_tolerance: args.goal_tolerance,
+        planner: args.planner,
+        radius,
+        step: args.step,
+        seed: args.seed,
+        iterations: args.iterations,
+        explore: args.explore,
+        shortcut: args.shortcut,
     };
-    let mut planner = make_planner(args.planner, &map, space, args.seed)?;
     let spinner = progress.spinner("planning");
-    let status = if args.explore {
-        planner.solve(&problem, &mut MaxIterations(args.iterations))
-    } else {
-        planner.solve(&problem, &mut AnyOf(GoalReached, MaxIterations(args.iterations)))
-    };
+    let outcome =
+        plan_on_map(&map, &setup).with_context(|| format!("planning on {}", map_path.display()))?;
     spinner.finish_and_clear();
-    let c = planner.counters();
+    let c = outcome.counters;
     let mut out = String::new();
-    writeln!(out, "planner:          {} on a `{}` map", planner.name(), map.backend())?;
-    writeln!(out, "status:           {status:?}")?;
+    writeln!(out, "planner:          {} on a `{}` map", outcome.planner, map.backend())?;
+    writeln!(out, "status:           {:?}", outcome.status)?;
     writeln!(out, "samples:          {}", c.samples)?;
     writeln!(out, "vertices:         {}", c.vertices)?;
     writeln!(out, "edges:            {}", c.edges)?;
@@ -120,27 +111,25 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
         c.collision_checks,
         c.collision_time.as_secs_f64()
     )?;
-    for (i, goal) in problem.goals.iter().enumerate() {
-        match planner.path_to(i) {
+    for (i, goal) in setup.goals.iter().enumerate() {
+        match &outcome.paths[i] {
             Some(path) => {
-                let m = PathMetrics::of(&path);
+                let m = PathMetrics::of(path);
                 writeln!(
                     out,
                     "goal {i} ({:.2}, {:.2}, {:.2}): reached, path of {} vertices, {:.3} m, \
                      {} turns ({} steep), curviness {:.1}°",
-                    goal.center.x,
-                    goal.center.y,
-                    goal.center.z,
+                    goal.x,
+                    goal.y,
+                    goal.z,
                     path.len(),
                     m.length,
                     m.turns,
                     m.steep_turns,
                     m.curviness.to_degrees()
                 )?;
-                if args.shortcut {
-                    let short =
-                        shortcut_path(&map, &path, radius, &ShortcutConfig::standard(), args.seed);
-                    let m = PathMetrics::of(&short);
+                if let Some(short) = &outcome.shortcuts[i] {
+                    let m = PathMetrics::of(short);
                     writeln!(
                         out,
                         "        shortcut: {} vertices, {:.3} m, {} turns ({} steep), curviness {:.1}°",
@@ -155,32 +144,18 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
             None => writeln!(
                 out,
                 "goal {i} ({:.2}, {:.2}, {:.2}): not reached",
-                goal.center.x, goal.center.y, goal.center.z
+                goal.x, goal.y, goal.z
             )?,
         }
     }
     if let Some(file) = &args.roadmap_out {
-        write_obj_roadmap(file, planner.roadmap())?;
+        write_obj_roadmap(file, &outcome.roadmap)?;
     }
     if let Some(file) = &args.path_out {
-        let path = planner.path_to(0).unwrap_or_default();
+        let path = outcome.paths[0].clone().unwrap_or_default();
         let line = (!path.is_empty()).then(|| (0..path.len()).collect());
         write_obj_lines(file, &path, line.into_iter())?;
     }
     progress.say(out.trim_end());
     Ok(())
-}
-
-/// The planner `kind` on `map` ([`roadmap::named_planner_on`]). Every planner tests, after
-/// each added vertex, whether the goal is directly reachable by one free capsule step (the
-/// thesis's §6.2.3 variant), so their results compare. The Evasion RRT and the medial-axis
-/// planners run on the concrete backend of `map`: they need specific step hits and proximity
-/// queries, which a point-cloud map cannot give (thesis Table 5.2).
-pub(crate) fn make_planner(
-    kind: PlannerKind,
-    map: &AnyMap,
-    space: PlanningSpace,
-    seed: u64,
-) -> Result<Box<dyn Planner + '_>> {
-    Ok(named_planner_on(kind, map, space, seed)?)
 }

@@ -101,8 +101,22 @@ impl Grounded {
 pub fn segment_ground(args: &GroundSetup) -> Result<Grounded> {
     ensure!((1..=100_000).contains(&args.repeat), "--repeat must be in 1..=100000");
     let cloud = input::read_cloud(&args.frame, &args.input)?;
+    let grounded = segment_cloud_ground(&cloud, args)?;
+    if let Some(out) = &args.out {
+        write_ground(out, &cloud, &grounded.labels)?;
+    }
+    Ok(grounded)
+}
+
+/// [`segment_ground`] on a cloud in memory (the Python package's arrays): `args.frame` only
+/// names the frame in messages; `args.input` and `args.out` are not used.
+///
+/// # Errors
+/// A parameter out of range, an empty cloud, or no ground plane for the mount estimate.
+pub fn segment_cloud_ground(cloud: &PointCloud, args: &GroundSetup) -> Result<Grounded> {
+    ensure!((1..=100_000).contains(&args.repeat), "--repeat must be in 1..=100000");
     ensure!(!cloud.is_empty(), "{}: the frame has no points", args.frame.display());
-    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(&cloud));
+    let axes = args.axes.unwrap_or_else(|| AxesChoice::default_for(cloud));
     let sensor_axes = axes.sensor_axes();
     let (height, pitch, roll, estimated) = match args.mount {
         Some((h, p, r)) => {
@@ -111,7 +125,7 @@ pub fn segment_ground(args: &GroundSetup) -> Result<Grounded> {
             (h, p.to_radians(), r.to_radians(), None)
         }
         None => {
-            let e = super::frame_mount(&cloud, sensor_axes, &args.frame)?;
+            let e = super::frame_mount(cloud, sensor_axes, &args.frame)?;
             (e.height, e.pitch, e.roll, Some(e))
         }
     };
@@ -127,9 +141,6 @@ pub fn segment_ground(args: &GroundSetup) -> Result<Grounded> {
         times.push(t.elapsed().as_secs_f64());
     }
     let summary = summary.context("segmented")?;
-    if let Some(out) = &args.out {
-        write_ground(out, &cloud, &labels)?;
-    }
     Ok(Grounded {
         labels,
         summary,
