@@ -74,6 +74,13 @@ class Cloud:
             return self.points
         return self.points.reshape(self.shape[0], self.shape[1], 3)
 
+    def world_points(self) -> np.ndarray:
+        """The points in the world frame (``pose`` applied; the points as they are without
+        one), N x 3 with the NaN rows kept."""
+        if self.pose is None:
+            return self.points
+        return self.points @ self.pose[:3, :3].T + self.pose[:3, 3]
+
 
 def read_cloud(path: Any, *, skip_non_finite: bool = False, depth: Optional[str] = None) -> Cloud:
     """Reads a cloud, range image or scan file in any format ``patchnav`` reads.

@@ -37,6 +37,9 @@ def test_read_cloud_gives_points_attributes_shape_and_pose(lab_scans):
     for name, values in attributes.items():
         assert len(values) == len(points), name
     assert "Cloud(" in repr(cloud)
+    world = cloud.world_points()[valid]
+    expected = points[valid] @ cloud.pose[:3, :3].T + cloud.pose[:3, 3]
+    assert np.allclose(world, expected)
 
 
 @pytest.mark.parametrize("hybrid", [False, True])
