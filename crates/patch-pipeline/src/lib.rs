@@ -18,6 +18,8 @@
 //! * [`tof`]: reading and filtering a time-of-flight frame (AAT, unwrapping, two frequencies).
 //! * [`names`]: every vocabulary by name ([`names::Named`], [`names::NameParser`]).
 //! * [`run_config`]: `patchnav run`, the demo's job on the user's data from a TOML file.
+//! * [`plan`]: one planning run on a map ([`plan::plan_on_map`]), as `patchnav plan` and the
+//!   Python package run it.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
