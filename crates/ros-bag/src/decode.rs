@@ -2,6 +2,7 @@
 
 use crate::bag::MessageRef;
 use crate::error::BagError;
+use crate::image::{CAMERA_INFO, CameraInfo, IMAGE, Image};
 use crate::msgs::{
     self, Header, LASER_SCAN, LaserScan, POINT_CLOUD2, PointCloud2Msg, TF_MESSAGE, TransformStamped,
 };
@@ -79,6 +80,31 @@ impl MessageRef<'_> {
             source,
         })?;
         Ok((msg.header, cloud))
+    }
+
+    /// The message as a `sensor_msgs/CameraInfo`.
+    pub fn camera_info(&self) -> Result<CameraInfo, BagError> {
+        let encoding = self.expect_type(CAMERA_INFO)?;
+        CameraInfo::decode(self.data, encoding).map_err(|e| self.wire_error(e))
+    }
+
+    /// The message as a `sensor_msgs/Image`.
+    pub fn image(&self) -> Result<Image, BagError> {
+        let encoding = self.expect_type(IMAGE)?;
+        Image::decode(self.data, encoding).map_err(|e| self.wire_error(e))
+    }
+
+    /// A depth image (`sensor_msgs/Image`, `16UC1` or `32FC1`) as an organised cloud in its
+    /// optical frame by the pinhole model of `info`, with its header (see [`crate::image`]).
+    pub fn depth_cloud(&self, info: &CameraInfo) -> Result<(Header, PointCloud), BagError> {
+        let image = self.image()?;
+        let cloud = image.to_cloud(info).map_err(|source| BagError::Depth {
+            path: self.file.to_owned(),
+            offset: self.offset,
+            topic: self.topic.to_owned(),
+            source,
+        })?;
+        Ok((image.header, cloud))
     }
 
     /// The message as a `tf2_msgs/TFMessage`.

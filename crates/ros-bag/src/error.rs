@@ -95,6 +95,18 @@ pub enum BagError {
         /// What is wrong with the cloud.
         source: Pc2Error,
     },
+    /// A depth image that cannot become a cloud (encoding, size, camera info).
+    #[error("{}, byte {offset}, topic {topic}: {source}", path.display())]
+    Depth {
+        /// The file.
+        path: PathBuf,
+        /// Where the image is.
+        offset: u64,
+        /// Its topic.
+        topic: String,
+        /// What is wrong.
+        source: crate::image::DepthError,
+    },
     /// A cloud whose transform to the fixed frame cannot be looked up.
     #[error("{}, byte {offset}, topic {topic}: {source}", path.display())]
     Tf {

@@ -5,9 +5,11 @@
 //!   `.bag` file; [`Bag::for_each_message`] walks the messages in file order as
 //!   [`MessageRef`]s, which decode themselves: [`MessageRef::cloud`] (a
 //!   `sensor_msgs/PointCloud2` as a [`pointcloud::PointCloud`], organised clouds kept
-//!   organised, or a `sensor_msgs/LaserScan` as one organised row), [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
+//!   organised, or a `sensor_msgs/LaserScan` as one organised row), [`MessageRef::depth_cloud`]
+//!   (a depth `sensor_msgs/Image` with its `sensor_msgs/CameraInfo`, [`image`]),
+//!   [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
 //! * [`BagInfo::of`]: topics, types, counts, time span and frames.
-//! * [`read_scans`]: the clouds of a topic, picked by time window, count or motion, each posed
+//! * [`read_scans`]: the clouds (or depth images) of a topic, picked by time window, count or motion, each posed
 //!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated).
 //! * [`BagWriter`]: small MCAP and ROS 1 bags of clouds and transforms (fixtures and tests).
 //!
@@ -29,6 +31,7 @@
 mod bag;
 mod decode;
 mod error;
+pub mod image;
 mod info;
 pub mod msgs;
 mod scans;
@@ -40,6 +43,6 @@ pub use bag::{Bag, BagFormat, MessageRef};
 pub use error::BagError;
 pub use info::{BagInfo, TopicInfo};
 pub use msgs::{Header, PointCloud2Msg, TransformStamped};
-pub use scans::{BagScan, BagScans, ScanQuery, read_scans};
+pub use scans::{BagScan, BagScans, ScanQuery, TRAJECTORY_FRAME, read_scans, sibling_camera_info};
 pub use tf::{TfError, TfTree};
 pub use write::{BagWriter, TopicId};

@@ -1,6 +1,6 @@
 //! The message types this crate decodes and encodes: `std_msgs/Header`,
 //! `sensor_msgs/PointCloud2`, `sensor_msgs/LaserScan` and `tf2_msgs/TFMessage`, in either
-//! [`Encoding`].
+//! [`Encoding`] (depth images and camera infos are in [`crate::image`]).
 
 use crate::wire::{Encoding, Reader, WireError, Writer};
 use pointcloud::io::pointcloud2::{PointCloud2, PointField};
@@ -372,6 +372,36 @@ pub(crate) fn definition(type_name: &str, encoding: Encoding) -> Option<(String,
                 "float32 range_min\nfloat32 range_max\nfloat32[] ranges\nfloat32[] intensities\n",
             ),
             "90c7ef2dc6895d81024acba2ac42f369",
+        ),
+        crate::image::IMAGE => (
+            concat!(
+                "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\n",
+                "uint8 is_bigendian\nuint32 step\nuint8[] data\n",
+            ),
+            "060021388200f6f0f447d0fcd9c64743",
+        ),
+        // ROS 1 names the matrices D, K, R, P; ROS 2 d, k, r, p. The layout is the same.
+        crate::image::CAMERA_INFO if encoding == Encoding::Ros1 => (
+            concat!(
+                "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n",
+                "float64[] D\nfloat64[9] K\nfloat64[9] R\nfloat64[12] P\nuint32 binning_x\n",
+                "uint32 binning_y\nsensor_msgs/RegionOfInterest roi\n",
+                "================================================================================\n",
+                "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\n",
+                "uint32 height\nuint32 width\nbool do_rectify\n",
+            ),
+            "c9a58c1b0b154e0e6da7578cb991d214",
+        ),
+        crate::image::CAMERA_INFO => (
+            concat!(
+                "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n",
+                "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\n",
+                "uint32 binning_y\nsensor_msgs/RegionOfInterest roi\n",
+                "================================================================================\n",
+                "MSG: sensor_msgs/RegionOfInterest\nuint32 x_offset\nuint32 y_offset\n",
+                "uint32 height\nuint32 width\nbool do_rectify\n",
+            ),
+            "c9a58c1b0b154e0e6da7578cb991d214",
         ),
         _ => return None,
     };

@@ -2,15 +2,37 @@
 
 use crate::bag::Bag;
 use crate::error::BagError;
-use crate::msgs::TF_MESSAGE;
+use crate::image::{CameraInfo, IMAGE};
+use crate::msgs::{Header, TF_MESSAGE, TransformStamped};
 use crate::tf::TfTree;
-use pointcloud::{PointCloud, SensorPose};
+use pointcloud::{Isometry3, PointCloud, SensorPose};
+
+/// The frame [`ScanQuery::trajectory`] poses the clouds in.
+pub const TRAJECTORY_FRAME: &str = "trajectory";
+
+/// The `camera_info` topic next to an image topic.
+pub fn sibling_camera_info(image_topic: &str) -> String {
+    match image_topic.rsplit_once('/') {
+        Some((dir, _)) => format!("{dir}/camera_info"),
+        None => "camera_info".to_owned(),
+    }
+}
 
 /// Which clouds [`read_scans`] takes and where it poses them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScanQuery {
-    /// The `sensor_msgs/PointCloud2` or `sensor_msgs/LaserScan` topic.
+    /// The `sensor_msgs/PointCloud2`, `sensor_msgs/LaserScan` or depth `sensor_msgs/Image`
+    /// topic.
     pub topic: String,
+    /// For a depth image topic: its `sensor_msgs/CameraInfo` topic (`None`: the sibling
+    /// `camera_info` of the image topic, `/camera/depth/image_rect` →
+    /// `/camera/depth/camera_info`). Each image takes the latest camera info before it in the
+    /// bag, or the first one when none came before.
+    pub camera_info: Option<String>,
+    /// `fixed_from_sensor` samples (stamps in nanoseconds, in order): pose the clouds by
+    /// these, interpolated at each cloud's stamp, instead of by `/tf` (a trajectory from
+    /// odometry or SLAM for a bag without transforms).
+    pub trajectory: Option<Vec<(i64, Isometry3)>>,
     /// The frame the scans are posed in (`odom`, `map`); `None`: the root of the first cloud's
     /// transform chain, or, without any transform to it, the sensor frame (no pose).
     pub fixed_frame: Option<String>,
@@ -30,6 +52,8 @@ impl ScanQuery {
     pub fn all(topic: &str) -> ScanQuery {
         ScanQuery {
             topic: topic.to_owned(),
+            camera_info: None,
+            trajectory: None,
             fixed_frame: None,
             every: 1,
             min_motion: None,
@@ -81,13 +105,19 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
     let mut start_ns = u64::MAX;
     let mut any_tf = false;
     let mut first_frame: Option<String> = None;
+    let info_topic = query.camera_info.clone().unwrap_or_else(|| sibling_camera_info(&query.topic));
+    let mut first_info: Option<CameraInfo> = None;
+    let mut is_image = false;
     bag.for_each_message(|m| {
         start_ns = start_ns.min(m.log_time_ns);
-        if m.type_name == TF_MESSAGE {
+        if m.type_name == TF_MESSAGE && query.trajectory.is_none() {
             tree.insert(&m.transforms()?, m.topic == "/tf_static");
             any_tf = true;
         } else if m.topic == query.topic && first_frame.is_none() {
             first_frame = m.header()?.map(|h| h.frame_id);
+            is_image = m.type_name == IMAGE;
+        } else if m.topic == info_topic && first_info.is_none() && m.type_name != IMAGE {
+            first_info = Some(m.camera_info()?);
         }
         Ok(())
     })?;
@@ -97,8 +127,29 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
             reason: format!("no message on topic {}", query.topic),
         });
     };
+    if is_image && first_info.is_none() {
+        return Err(BagError::NotABag {
+            path: bag.path().to_owned(),
+            reason: format!(
+                "{} holds images but {info_topic} no sensor_msgs/CameraInfo (give its topic)",
+                query.topic
+            ),
+        });
+    }
+    if let Some(samples) = &query.trajectory {
+        let transforms: Vec<TransformStamped> = samples
+            .iter()
+            .map(|&(stamp_ns, pose)| TransformStamped {
+                header: Header { stamp_ns, frame_id: TRAJECTORY_FRAME.to_owned() },
+                child_frame_id: first_frame.clone(),
+                parent_from_child: pose,
+            })
+            .collect();
+        tree.insert(&transforms, false);
+    }
     let mut warnings = Vec::new();
     let fixed_frame = match &query.fixed_frame {
+        _ if query.trajectory.is_some() => Some(TRAJECTORY_FRAME.to_owned()),
         Some(f) => Some(f.clone()),
         None => {
             let root = tree.root(&first_frame);
@@ -118,7 +169,11 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
     let mut scans = Vec::new();
     let (mut on_topic, mut in_window) = (0usize, 0usize);
     let mut last_kept: Option<pointcloud::Point3> = None;
+    let mut info = first_info;
     bag.for_each_message(|m| {
+        if is_image && m.topic == info_topic {
+            info = Some(m.camera_info()?);
+        }
         if m.topic != query.topic {
             return Ok(());
         }
@@ -131,7 +186,10 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
         if (in_window - 1) % query.every.max(1) != 0 {
             return Ok(());
         }
-        let (header, mut cloud) = m.cloud()?;
+        let (header, mut cloud) = match &info {
+            Some(info) if is_image => m.depth_cloud(info)?,
+            _ => m.cloud()?,
+        };
         if let Some(fixed) = &fixed_frame {
             let fixed_from_sensor =
                 tree.lookup(fixed, &header.frame_id, header.stamp_ns).map_err(|source| {
