@@ -305,9 +305,8 @@ impl CameraInfo {
         } else {
             (self.k[0], self.k[4], self.k[2], self.k[5])
         };
-        if !(fx.is_finite() && fy.is_finite() && fx > 0.0 && fy > 0.0)
-            || !(cx.is_finite() && cy.is_finite())
-        {
+        let focal = fx.is_finite() && fy.is_finite() && fx > 0.0 && fy > 0.0;
+        if !(focal && cx.is_finite() && cy.is_finite()) {
             return Err(DepthError::Camera(format!(
                 "focal lengths ({fx}, {fy}) and principal point ({cx}, {cy}) are not a camera"
             )));
