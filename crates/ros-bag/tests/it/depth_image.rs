@@ -23,7 +23,7 @@ fn depths() -> Vec<Option<f32>> {
         .flat_map(|v| {
             (0..W).map(move |u| {
                 let hole = (15..20).contains(&u) && (10..14).contains(&v);
-                (!hole).then(|| 1.5 + 0.03 * u as f32 + 0.001 * v as f32)
+                (!hole).then_some(1.5 + 0.03 * u as f32 + 0.001 * v as f32)
             })
         })
         .collect()
