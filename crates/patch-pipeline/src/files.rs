@@ -1,5 +1,5 @@
-//! The files the programs read and write around the pipeline: scan poses (`poses.json`) and
-//! map files of any backend.
+//! The files the programs read and write around the pipeline: scan poses (`poses.json`),
+//! trajectories (TUM format) and map files of any backend.
 
 use anyhow::{Context, Result, bail};
 use patch_core::{Aabb, Isometry3, Patch, Real, na};
@@ -67,6 +67,56 @@ pub fn rigid_from_rows(m: &[Real]) -> Result<Isometry3> {
     let rotation = na::UnitQuaternion::from_matrix(&r);
     let translation = na::Translation3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]);
     Ok(Isometry3::from_parts(translation, rotation))
+}
+
+/// Reads a trajectory in the TUM RGB-D format: one pose per line, `timestamp tx ty tz qx qy qz
+/// qw` (seconds, metres, a unit quaternion; spaces or commas between the numbers), `#` comment
+/// lines. Returns `(stamp in nanoseconds, world_from_sensor)` in file order.
+///
+/// # Errors
+/// An unreadable file, a line without 8 finite numbers, a zero quaternion, stamps that do not
+/// increase, or no pose at all; every error names the line.
+pub fn read_trajectory(path: &Path) -> Result<Vec<(i64, Isometry3)>> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut out: Vec<(i64, Isometry3)> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let at = || format!("{}, line {}", path.display(), i + 1);
+        let v: Vec<Real> = line
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|s| !s.is_empty())
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("{}: not numbers", at()))?;
+        if v.len() != 8 || !v.iter().all(|x| x.is_finite()) {
+            bail!("{}: want 8 finite numbers `t tx ty tz qx qy qz qw`, got {}", at(), v.len());
+        }
+        let q = na::Quaternion::new(v[7], v[4], v[5], v[6]);
+        if q.norm() < 1e-9 {
+            bail!("{}: the quaternion is zero", at());
+        }
+        let stamp_ns = (v[0] * 1e9).round();
+        if stamp_ns.abs() > 9e18 {
+            bail!("{}: time {} s is out of range", at(), v[0]);
+        }
+        let stamp_ns = stamp_ns as i64;
+        if out.last().is_some_and(|&(last, _)| stamp_ns <= last) {
+            bail!("{}: the stamps must increase", at());
+        }
+        let pose = Isometry3::from_parts(
+            na::Translation3::new(v[1], v[2], v[3]),
+            na::UnitQuaternion::from_quaternion(q),
+        );
+        out.push((stamp_ns, pose));
+    }
+    if out.is_empty() {
+        bail!("{}: no pose", path.display());
+    }
+    Ok(out)
 }
 
 /// Reads a map file of any backend.

@@ -6,7 +6,9 @@
 //! `patchnav extract BAG --topic T [--fixed-frame F] [--every N | --min-motion M] [--start S]
 //! [--end S]` takes the scans from the `sensor_msgs/PointCloud2` messages of a ROS bag (`.mcap`,
 //! rosbag2 folder, ROS 1 `.bag`), each posed by the bag's `/tf` and `/tf_static` at its stamp
-//! (`ros_bag::read_scans`).
+//! (`ros_bag::read_scans`), or by a trajectory (`--poses`, TUM format). A depth image topic
+//! (`sensor_msgs/Image`, 16UC1 or 32FC1) gives organised clouds through its
+//! `sensor_msgs/CameraInfo` (`--camera-info`, default the sibling `camera_info` topic).
 //!
 //! Each scan is read in its sensor frame with its pose: PLY files written by `patchnav
 //! simulate` carry it, PCD files have `VIEWPOINT`, 3DTK `.3d` scans the sibling `.pose` file.
@@ -38,7 +40,7 @@ use patch_extract::pipeline::{PipelineConfig, extract_with_threads};
 use patch_extract::visibility::Carved;
 use patch_map::Backend;
 pub use patch_pipeline::SensorPreset;
-use patch_pipeline::files::{read_poses, save_patches};
+use patch_pipeline::files::{read_poses, read_trajectory, save_patches};
 use patch_pipeline::preset::ExtractChoices;
 use pointcloud::{PointCloud, PolygonMesh, SensorPose};
 use serde_json::{Value, json};
@@ -57,8 +59,12 @@ pub struct ExtractArgs {
     #[arg(long)]
     pub topic: Option<String>,
     /// The frame bag scans are posed in (default: the root of the clouds' transform chain).
-    #[arg(long, requires = "topic")]
+    #[arg(long, requires = "topic", conflicts_with = "poses")]
     pub fixed_frame: Option<String>,
+    /// For a depth image topic: its `sensor_msgs/CameraInfo` topic (default: the sibling
+    /// `camera_info` of the image topic).
+    #[arg(long, requires = "topic")]
+    pub camera_info: Option<String>,
     /// Take every N-th cloud of the bag's time window.
     #[arg(long, requires = "topic", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     pub every: u64,
@@ -105,7 +111,10 @@ pub struct ExtractArgs {
     /// surfaces alone.
     #[arg(long)]
     pub slab_thickness: Option<f64>,
-    /// A poses JSON overriding the scans' own poses.
+    /// Poses overriding the scans' own: for scan files a poses JSON; for a bag a trajectory in
+    /// the TUM format (`t tx ty tz qx qy qz qw` per line, `world_from_sensor` at time t in
+    /// seconds, the clock of the clouds' stamps), interpolated at each cloud's stamp instead of
+    /// `/tf`.
     #[arg(long)]
     pub poses: Option<PathBuf>,
     /// Scans extracted at once (default: one per core; the result does not depend on it).
@@ -152,11 +161,12 @@ fn read_bag_scans(
     let Some(topic) = &args.topic else {
         bail!("{}: a bag needs --topic (`patchnav info` lists its topics)", bag.display());
     };
-    if args.poses.is_some() {
-        bail!("--poses is for scan files; a bag's scans are posed by its /tf");
-    }
+    let trajectory = args.poses.as_deref().map(read_trajectory).transpose()?;
     let query = ros_bag::ScanQuery {
         topic: topic.clone(),
+        camera_info: args.camera_info.clone(),
+        trajectory,
+        posed: true,
         fixed_frame: args.fixed_frame.clone(),
         every: args.every as usize,
         min_motion: args.min_motion,

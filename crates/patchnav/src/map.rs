@@ -455,7 +455,7 @@ fn compare(args: &CompareArgs, progress: &Progress) -> Result<()> {
             "unsafe_by_truth_surface": misses,
             "overcautious_by_test_surface": blocks,
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        crate::progress::print_line(&serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
     let mut out = String::new();

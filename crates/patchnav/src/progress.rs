@@ -41,13 +41,28 @@ impl Progress {
     /// Prints the result a command exists to print (an experiment's tables): unlike
     /// [`Progress::say`], `--quiet` does not silence it.
     pub fn report(&self, text: impl AsRef<str>) {
-        println!("{}", text.as_ref());
+        print_line(text.as_ref());
     }
 
     /// Prints a summary line on standard output unless quiet.
     pub fn say(&self, line: impl AsRef<str>) {
         if !self.quiet {
-            println!("{}", line.as_ref());
+            print_line(line.as_ref());
+        }
+    }
+}
+
+/// Prints a line on standard output. A closed pipe (`patchnav ... | head`) ends the program
+/// quietly, as other command-line tools do, instead of panicking in `println!`.
+pub fn print_line(text: &str) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{text}").and_then(|()| out.flush()) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(e) => {
+            eprintln!("error: writing to standard output: {e}");
+            std::process::exit(1);
         }
     }
 }

@@ -1,18 +1,31 @@
 //! `patchnav terrain FRAME`: the terrain class and drivability of the view ahead by the plane
 //! Hough transform ([`patch_pipeline::terrain`]; thesis Ch. 4, Algorithms 2 and 3).
+//! `patchnav terrain BAG --topic T`: the same for every message of a bag's cloud or depth
+//! image topic, one line each.
 
 use crate::input::InputArgs;
 use crate::progress::Progress;
-use anyhow::Result;
+use anyhow::{Result, bail};
 use patch_pipeline::terrain::ground::{GROUND_FIELD, GroundSetup, segment_ground};
-use patch_pipeline::terrain::{AxesChoice, Classified, Method, TerrainSetup, class_name, classify};
+use patch_pipeline::terrain::{
+    AxesChoice, Classified, Method, TerrainSetup, class_name, classify, classify_cloud,
+};
 use std::path::PathBuf;
 
 /// Arguments of `patchnav terrain`.
 #[derive(Debug, clap::Args)]
 pub struct TerrainArgs {
-    /// A range frame or point cloud (.ply .pcd .xyz .txt .bin .3d, or a 16-bit .png depth image).
+    /// A range frame or point cloud (.ply .pcd .xyz .txt .bin .3d, or a 16-bit .png depth
+    /// image), or a ROS bag (.mcap, a rosbag2 folder, .bag) with --topic.
     pub frame: PathBuf,
+    /// The bag's cloud topic (`sensor_msgs/PointCloud2`, `LaserScan`, or a depth `Image`):
+    /// every message is classified, one result line each.
+    #[arg(long)]
+    pub topic: Option<String>,
+    /// For a depth image topic: its `sensor_msgs/CameraInfo` topic (default: the sibling
+    /// `camera_info`).
+    #[arg(long, requires = "topic")]
+    pub camera_info: Option<String>,
     /// Angular resolution of the Hough space, degrees (thesis: 45 for drivability, 15 or 9 for
     /// classes).
     #[arg(long, default_value_t = 15.0)]
@@ -79,6 +92,9 @@ impl TerrainArgs {
 
 /// Runs `patchnav terrain`.
 pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
+    if crate::extract::is_bag(&args.frame) || args.topic.is_some() {
+        return run_bag(args, progress);
+    }
     let classified = classify(&args.setup())?;
     let ground = match &args.ground_out {
         Some(out) => Some(segment_ground(&GroundSetup {
@@ -201,6 +217,61 @@ pub fn run(args: &TerrainArgs, progress: &Progress) -> Result<()> {
             class_name(&s.classification),
             if s.classification.drivable { "yes" } else { "no" }
         ));
+    }
+    Ok(())
+}
+
+/// `patchnav terrain BAG --topic T`: every message of the topic classified, one line (or JSON
+/// object) each, in bag order; the mount is estimated per message unless given.
+fn run_bag(args: &TerrainArgs, progress: &Progress) -> Result<()> {
+    let Some(topic) = &args.topic else {
+        bail!("{}: a bag needs --topic (`patchnav info` lists its topics)", args.frame.display());
+    };
+    if !crate::extract::is_bag(&args.frame) {
+        bail!("--topic takes a ROS bag (.mcap, a rosbag2 folder, .bag)");
+    }
+    if args.ground_out.is_some() || args.hough_png.is_some() {
+        bail!("--ground-out and --hough-png write one frame: give a frame file, not a bag");
+    }
+    let query = ros_bag::ScanQuery {
+        camera_info: args.camera_info.clone(),
+        posed: false,
+        ..ros_bag::ScanQuery::all(topic)
+    };
+    let bag = ros_bag::Bag::open(&args.frame)?;
+    let summary = ros_bag::for_each_scan(&bag, &query, |scan| -> Result<()> {
+        let name = format!("{} {topic} at {:.3} s", args.frame.display(), scan.time_s);
+        let setup = TerrainSetup { frame: PathBuf::from(&name), ..args.setup() };
+        let c = classify_cloud(&scan.cloud, &setup)?;
+        let (height, pitch, roll) = c.mount;
+        if args.json {
+            let row = serde_json::json!({
+                "frame": name, "time_s": scan.time_s, "stamp_ns": scan.stamp_ns,
+                "points": c.cloud_points, "points_used": c.points.len(),
+                "class": class_name(&c.result), "drivable": c.result.drivable,
+                "rule": format!("{:?}", c.result.rule), "time_ms": c.seconds * 1e3,
+                "mount": {"height_m": height, "pitch_deg": pitch, "roll_deg": roll,
+                    "estimated": c.estimated.is_some()},
+            });
+            progress.report(row.to_string());
+        } else {
+            progress.report(format!(
+                "{:>9.3} s  {:<9} drivable {:<3}  {:?}; {} of {} points; mount {height:.2} m, \
+                 pitch {pitch:.1}°, roll {roll:.1}°{}",
+                scan.time_s,
+                class_name(&c.result),
+                if c.result.drivable { "yes" } else { "no" },
+                c.result.rule,
+                c.points.len(),
+                c.cloud_points,
+                if c.estimated.is_some() { " (estimated)" } else { "" }
+            ));
+        }
+        Ok(())
+    })?;
+    if !args.json {
+        let (on_topic, _, kept) = summary.counts;
+        progress.say(format!("{kept} of {on_topic} messages on {topic} classified"));
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 //!     [--clamp-corners] [--range2 R2.png --amplitude2 A2.png --meta2 M2.json]
 //!     --out cloud.ply [--png outcomes.png] [--dense|--safe]
 //! patchnav tof filter --cloud F.ply --meta M.json ...
+//! patchnav tof filter --cloud BAG --topic T --meta M.json ...   (one line per message)
 //! patchnav tof calibrate [WHITE_WALL] [--range R.png --amplitude A.png] --meta M.json
 //!     [--fixed-curvature] [--radial] [--trim SIGMA] [--table T.json] --out calib.json
 //! ```
@@ -16,12 +17,14 @@
 //! camera.
 
 use crate::progress::Progress;
-use anyhow::Result;
+use anyhow::{Context, Result, bail};
 use clap::Args;
-use patch_pipeline::tof::{FilterSetup, FrameSource, Method, filter_frame, load_frame};
+use patch_pipeline::tof::{
+    FilterSetup, FrameSource, Method, filter_frame, filter_loaded, load_frame,
+};
 use pointcloud::Real;
 use sensor_tof::calibrate::{CalibrationOptions, fit_parabola, white_wall_table};
-use sensor_tof::io::{write_json, write_rgb_png};
+use sensor_tof::io::{frame_from_cloud, read_meta, write_json, write_rgb_png};
 use sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD;
 use sensor_tof::{AatRange, FilterOutput, PixelOutcome, TofFrame};
 use std::path::PathBuf;
@@ -121,9 +124,13 @@ pub struct FilterArgs {
     /// Two-frequency: both amplitudes must exceed this.
     #[arg(long)]
     pub min_amplitude: Option<Real>,
+    /// With a ROS bag as --cloud: its topic of organised `sensor_msgs/PointCloud2` frames whose
+    /// intensity is the amplitude; every message is filtered, one result line each.
+    #[arg(long, requires = "cloud", conflicts_with_all = ["out", "png"])]
+    pub topic: Option<String>,
     /// The output cloud (.ply .pcd .xyz ...).
-    #[arg(long)]
-    pub out: PathBuf,
+    #[arg(long, required_unless_present = "topic")]
+    pub out: Option<PathBuf>,
     /// Also write an RGB image of the outcomes.
     #[arg(long)]
     pub png: Option<PathBuf>,
@@ -210,6 +217,13 @@ pub fn run(command: &TofCommand, progress: &Progress) -> Result<()> {
 }
 
 fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
+    if let Some(topic) = &args.topic {
+        return filter_bag(args, topic, progress);
+    }
+    let Some(out) = &args.out else { bail!("give --out (or a bag with --topic)") };
+    if args.cloud.as_deref().is_some_and(crate::extract::is_bag) {
+        bail!("a bag as --cloud needs --topic (`patchnav info` lists its topics)");
+    }
     let (frame, output, name) = filter_frame(&args.setup())?;
     let mut written = output.clone();
     if args.safe {
@@ -221,7 +235,7 @@ fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
         }
     }
     let cloud = written.to_cloud(&frame, false);
-    pointcloud::io::write_cloud(&args.out, &cloud)?;
+    pointcloud::io::write_cloud(out, &cloud)?;
     if let Some(png) = &args.png {
         let rgb = outcome_image(&frame, &output);
         write_rgb_png(png, frame.camera().width, frame.camera().height, &rgb)?;
@@ -237,8 +251,42 @@ fn filter(args: &FilterArgs, progress: &Progress) -> Result<()> {
         c.dropped,
         c.discarded_percent(),
         cloud.len(),
-        args.out.display()
+        out.display()
     ));
+    Ok(())
+}
+
+/// `patchnav tof filter --cloud BAG --topic T --meta M`: every organised cloud of the topic (its
+/// intensity the amplitude) filtered as one frame of the sidecar's camera, one line each.
+fn filter_bag(args: &FilterArgs, topic: &str, progress: &Progress) -> Result<()> {
+    let Some(path) = &args.cloud else { bail!("--topic needs a bag as --cloud") };
+    if !crate::extract::is_bag(path) {
+        bail!("--topic takes a ROS bag (.mcap, a rosbag2 folder, .bag) as --cloud");
+    }
+    let setup = args.setup();
+    let meta = read_meta(&args.frame.meta)?;
+    let camera = meta.camera()?;
+    let query = ros_bag::ScanQuery { posed: false, ..ros_bag::ScanQuery::all(topic) };
+    let bag = ros_bag::Bag::open(path)?;
+    let summary = ros_bag::for_each_scan(&bag, &query, |scan| -> Result<()> {
+        let at = format!("{} {topic} at {:.3} s", path.display(), scan.time_s);
+        let frame =
+            frame_from_cloud(&scan.cloud, &camera, meta.range_kind).with_context(|| at.clone())?;
+        let (output, name) = filter_loaded(&frame, &meta, &setup).with_context(|| at.clone())?;
+        let c = output.counts;
+        progress.report(format!(
+            "{:>9.3} s  {name}: {} measured: {} kept, {} unwrapped, {} dropped ({:.1} % discarded)",
+            scan.time_s,
+            frame.num_measured(),
+            c.kept,
+            c.unwrapped,
+            c.dropped,
+            c.discarded_percent()
+        ));
+        Ok(())
+    })?;
+    let (on_topic, _, kept) = summary.counts;
+    progress.say(format!("{kept} of {on_topic} messages on {topic} filtered"));
     Ok(())
 }
 

@@ -119,6 +119,10 @@ pub enum BagError {
         /// The broken chain or the missing time.
         source: Box<TfError>,
     },
+    /// A walk stopped by its caller's callback ([`crate::for_each_scan`] returns the
+    /// callback's own error instead).
+    #[error("stopped by the caller")]
+    Stopped,
     /// A bag could not be written.
     #[error("writing a bag: {0}")]
     Write(String),

@@ -10,7 +10,8 @@
 //!   [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
 //! * [`BagInfo::of`]: topics, types, counts, time span and frames.
 //! * [`read_scans`]: the clouds (or depth images) of a topic, picked by time window, count or motion, each posed
-//!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated).
+//!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated) or a
+//!   trajectory; [`for_each_scan`] hands them over one at a time.
 //! * [`BagWriter`]: small MCAP and ROS 1 bags of clouds and transforms (fixtures and tests).
 //!
 //! # Crates and what is written here
@@ -43,6 +44,9 @@ pub use bag::{Bag, BagFormat, MessageRef};
 pub use error::BagError;
 pub use info::{BagInfo, TopicInfo};
 pub use msgs::{Header, PointCloud2Msg, TransformStamped};
-pub use scans::{BagScan, BagScans, ScanQuery, TRAJECTORY_FRAME, read_scans, sibling_camera_info};
+pub use scans::{
+    BagScan, BagScans, ScanQuery, ScanSummary, TRAJECTORY_FRAME, for_each_scan, read_scans,
+    sibling_camera_info,
+};
 pub use tf::{TfError, TfTree};
 pub use write::{BagWriter, TopicId};

@@ -33,6 +33,9 @@ pub struct ScanQuery {
     /// these, interpolated at each cloud's stamp, instead of by `/tf` (a trajectory from
     /// odometry or SLAM for a bag without transforms).
     pub trajectory: Option<Vec<(i64, Isometry3)>>,
+    /// Pose the clouds (`false`: leave them in their sensor frame without looking up any
+    /// transform, for per-frame work such as terrain classes).
+    pub posed: bool,
     /// The frame the scans are posed in (`odom`, `map`); `None`: the root of the first cloud's
     /// transform chain, or, without any transform to it, the sensor frame (no pose).
     pub fixed_frame: Option<String>,
@@ -54,6 +57,7 @@ impl ScanQuery {
             topic: topic.to_owned(),
             camera_info: None,
             trajectory: None,
+            posed: true,
             fixed_frame: None,
             every: 1,
             min_motion: None,
@@ -101,6 +105,40 @@ pub struct BagScans {
 /// chain is broken or its stamp lies outside the samples; [`BagError::NotABag`] when the topic
 /// holds no cloud.
 pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
+    let mut scans = Vec::new();
+    let summary = for_each_scan(bag, query, |scan| {
+        scans.push(scan);
+        Ok::<(), BagError>(())
+    })?;
+    Ok(BagScans {
+        scans,
+        fixed_frame: summary.fixed_frame,
+        counts: summary.counts,
+        warnings: summary.warnings,
+    })
+}
+
+/// What [`for_each_scan`] walked: [`BagScans`] without the scans.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScanSummary {
+    /// The fixed frame, or `None` if the scans stay in their sensor frame.
+    pub fixed_frame: Option<String>,
+    /// Clouds of the topic in the bag, in the time window, and kept.
+    pub counts: (usize, usize, usize),
+    /// Things the caller should tell the user (no transforms, …).
+    pub warnings: Vec<String>,
+}
+
+/// [`read_scans`] one scan at a time: calls `f` with each scan kept, in bag order, so that a
+/// long bag is never in memory at once. Stops at the first error of the bag or of `f`.
+///
+/// # Errors
+/// As [`read_scans`], and whatever `f` returns.
+pub fn for_each_scan<E: From<BagError>>(
+    bag: &Bag,
+    query: &ScanQuery,
+    mut f: impl FnMut(BagScan) -> Result<(), E>,
+) -> Result<ScanSummary, E> {
     let mut tree = TfTree::new();
     let mut start_ns = u64::MAX;
     let mut any_tf = false;
@@ -122,19 +160,19 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
         Ok(())
     })?;
     let Some(first_frame) = first_frame else {
-        return Err(BagError::NotABag {
+        return Err(E::from(BagError::NotABag {
             path: bag.path().to_owned(),
             reason: format!("no message on topic {}", query.topic),
-        });
+        }));
     };
     if is_image && first_info.is_none() {
-        return Err(BagError::NotABag {
+        return Err(E::from(BagError::NotABag {
             path: bag.path().to_owned(),
             reason: format!(
                 "{} holds images but {info_topic} no sensor_msgs/CameraInfo (give its topic)",
                 query.topic
             ),
-        });
+        }));
     }
     if let Some(samples) = &query.trajectory {
         let transforms: Vec<TransformStamped> = samples
@@ -149,6 +187,7 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
     }
     let mut warnings = Vec::new();
     let fixed_frame = match &query.fixed_frame {
+        _ if !query.posed => None,
         _ if query.trajectory.is_some() => Some(TRAJECTORY_FRAME.to_owned()),
         Some(f) => Some(f.clone()),
         None => {
@@ -166,11 +205,12 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
     if !any_tf && query.fixed_frame.is_some() {
         warnings.push("the bag has no /tf or /tf_static".to_owned());
     }
-    let mut scans = Vec::new();
+    let mut kept = 0usize;
+    let mut failed: Option<E> = None;
     let (mut on_topic, mut in_window) = (0usize, 0usize);
     let mut last_kept: Option<pointcloud::Point3> = None;
     let mut info = first_info;
-    bag.for_each_message(|m| {
+    let walked = bag.for_each_message(|m| {
         if is_image && m.topic == info_topic {
             info = Some(m.camera_info()?);
         }
@@ -209,12 +249,19 @@ pub fn read_scans(bag: &Bag, query: &ScanQuery) -> Result<BagScans, BagError> {
             last_kept = Some(at);
             cloud.set_sensor_pose(Some(SensorPose { world_from_sensor: fixed_from_sensor }));
         }
-        scans.push(BagScan { stamp_ns: header.stamp_ns, time_s, frame_id: header.frame_id, cloud });
-        Ok(())
-    })?;
+        kept += 1;
+        let scan = BagScan { stamp_ns: header.stamp_ns, time_s, frame_id: header.frame_id, cloud };
+        f(scan).map_err(|e| {
+            failed = Some(e);
+            BagError::Stopped
+        })
+    });
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    walked?;
     if query.min_motion.is_some() && fixed_frame.is_none() {
         warnings.push("--min-motion needs poses: every cloud is kept".to_owned());
     }
-    let kept = scans.len();
-    Ok(BagScans { scans, fixed_frame, counts: (on_topic, in_window, kept), warnings })
+    Ok(ScanSummary { fixed_frame, counts: (on_topic, in_window, kept), warnings })
 }

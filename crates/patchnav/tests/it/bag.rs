@@ -245,3 +245,81 @@ fn extract_names_a_broken_chain_and_warns_without_tf() {
     assert!(stderr(&o).contains("warning: no transform from `laser`"), "{}", stderr(&o));
     assert!(stdout(&o).contains("posed in the sensor frame"), "{}", stdout(&o));
 }
+
+/// `terrain BAG --topic T` classifies every message: the simulated floor frames as floor.
+#[test]
+fn terrain_on_a_bag_classifies_every_message() {
+    let dir = tempfile::tempdir().unwrap();
+    // A range camera 0.5 m over a flat floor, looking ahead and slightly down.
+    let cloud = PointCloud::from_positions(
+        (0..40)
+            .flat_map(|i| (0..30).map(move |j| (i, j)))
+            .map(|(i, j)| Point3::new(1.0 + 0.1 * i as f64, -1.5 + 0.1 * j as f64, -0.5))
+            .collect(),
+    )
+    .unwrap();
+    let mut w = BagWriter::new(BagFormat::Ros1).unwrap();
+    let p = w.add_topic("/front/points", POINT_CLOUD2).unwrap();
+    for k in 0..4i64 {
+        let header = Header { stamp_ns: T0 + k * 100_000_000, frame_id: "lidar".into() };
+        w.write_cloud(p, &header, &encode(&cloud, &Pc2Layout::default()).unwrap()).unwrap();
+    }
+    let path = dir.path().join("floor.bag");
+    std::fs::write(&path, w.finish().unwrap()).unwrap();
+    let o = patchnav(&[
+        "terrain",
+        path.to_str().unwrap(),
+        "--topic",
+        "/front/points",
+        "--resolution",
+        "45",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let rows: Vec<&str> = text.lines().filter(|l| l.contains(" s  ")).collect();
+    assert_eq!(rows.len(), 4, "{text}");
+    assert!(rows.iter().all(|r| r.contains("floor") && r.contains("drivable yes")), "{text}");
+    let o = patchnav(&["terrain", path.to_str().unwrap(), "--topic", "/front/points", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: Vec<serde_json::Value> =
+        stdout(&o).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(json.len(), 4);
+    assert_eq!(json[3]["stamp_ns"], T0 + 300_000_000);
+    assert_one_line_error(&patchnav(&["terrain", path.to_str().unwrap()]), "needs --topic");
+    assert_one_line_error(
+        &patchnav(&["terrain", path.to_str().unwrap(), "--topic", "/nothing"]),
+        "no message on topic /nothing",
+    );
+}
+
+/// `extract BAG --topic T --poses TRAJECTORY`: a bag without /tf posed by a TUM trajectory.
+#[test]
+fn extract_poses_a_bag_by_a_trajectory() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    std::fs::write(&path, bag(BagFormat::Mcap)).unwrap();
+    let trajectory = dir.path().join("traj.txt");
+    std::fs::write(
+        &trajectory,
+        "# t tx ty tz qx qy qz qw\n1700000000.0 0 0 0.4 0 0 0 1\n1700000000.3 3 0 0.4 0 0 0 1\n",
+    )
+    .unwrap();
+    let out = dir.path().join("m.pmap");
+    let (b, t, o) = (path.to_str().unwrap(), trajectory.to_str().unwrap(), out.to_str().unwrap());
+    let run = patchnav(&[
+        "extract", b, "--topic", "/points", "--poses", t, "--out", o, "--sensor", "exact",
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(stdout(&run).contains("posed in trajectory"), "{}", stdout(&run));
+    std::fs::write(&trajectory, "1700000000.0 0 0 0.4 0 0 0 1\n1699999999.0 0 0 0 0 0 0 1\n")
+        .unwrap();
+    assert_one_line_error(
+        &patchnav(&["extract", b, "--topic", "/points", "--poses", t, "--out", o]),
+        "line 2: the stamps must increase",
+    );
+    std::fs::write(&trajectory, "1700000000.0 0 0 0.4 0 0 0\n").unwrap();
+    assert_one_line_error(
+        &patchnav(&["extract", b, "--topic", "/points", "--poses", t, "--out", o]),
+        "want 8 finite numbers",
+    );
+}

@@ -497,3 +497,42 @@ fn experiment_tof_prints_table_2_4() {
     // The yield table with the new mode, tuned on another seed.
     assert!(out.contains("regions (tuned)") && out.contains("yield%"), "{out}");
 }
+
+/// `tof filter --cloud BAG --topic T`: each frame of the bag filtered, one line each, with the
+/// same counts as the frame's PNG pair.
+#[test]
+fn a_bag_of_frames_filters_one_line_per_message() {
+    use ros_bag::msgs::POINT_CLOUD2;
+    use ros_bag::{BagFormat, BagWriter, Header};
+    let dir = tempfile::tempdir().unwrap();
+    let frame = scene(20e6, RangeKind::Depth);
+    let (r, a, m) = write_pair(dir.path(), "scene", &frame);
+    let meta = sensor_tof::io::read_meta(&m).unwrap();
+    let read = read_png_pair(&r, &a, &meta).unwrap();
+    let layout = pointcloud::io::pointcloud2::Pc2Layout::default();
+    let data = pointcloud::io::pointcloud2::encode(&read.to_cloud(), &layout).unwrap();
+    let mut w = BagWriter::new(BagFormat::Mcap).unwrap();
+    let topic = w.add_topic("/tof/points", POINT_CLOUD2).unwrap();
+    for k in 0..3i64 {
+        let header = Header { stamp_ns: 1_000_000_000 + k * 100_000_000, frame_id: "tof".into() };
+        w.write_cloud(topic, &header, &data).unwrap();
+    }
+    let bag = dir.path().join("tof.mcap");
+    std::fs::write(&bag, w.finish().unwrap()).unwrap();
+    let pair = filter_cmd(s(&r), s(&a), s(&m), &["--out", s(&dir.path().join("o.ply"))]);
+    assert!(pair.status.success(), "{}", stderr(&pair));
+    let [_, measured, kept, unwrapped, dropped, _] = summary(&stdout(&pair));
+    let o =
+        patchnav(&["tof", "filter", "--cloud", s(&bag), "--topic", "/tof/points", "--meta", s(&m)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let expected =
+        format!("{measured} measured: {kept} kept, {unwrapped} unwrapped, {dropped} dropped");
+    let lines: Vec<&str> = text.lines().filter(|l| l.contains(" s  regions")).collect();
+    assert_eq!(lines.len(), 3, "{text}");
+    assert!(lines.iter().all(|l| l.contains(&expected)), "{text}\nwant {expected}");
+    assert!(text.contains("3 of 3 messages on /tof/points filtered"), "{text}");
+    // A bag without --topic, or --topic with a file, is a one-line error.
+    let o = patchnav(&["tof", "filter", "--cloud", s(&bag), "--meta", s(&m), "--out", "x.ply"]);
+    assert_one_line_error(&o, "needs --topic");
+}
