@@ -498,6 +498,7 @@ mod tests {
             scans: vec![scan],
             topic: None,
             fixed_frame: None,
+            camera_info: None,
             every: 1,
             min_motion: None,
             start: None,
