@@ -18,6 +18,7 @@
 //! * [`tof`]: reading and filtering a time-of-flight frame (AAT, unwrapping, two frequencies).
 //! * [`names`]: every vocabulary by name ([`names::Named`], [`names::NameParser`]).
 //! * [`run_config`]: `patchnav run`, the demo's job on the user's data from a TOML file.
+//! * [`parallel`]: independent runs on all cores, results in input order.
 //! * [`plan`]: one planning run on a map ([`plan::plan_on_map`]), as `patchnav plan` and the
 //!   Python package run it.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
@@ -49,6 +50,7 @@ pub mod experiment;
 pub mod files;
 pub mod input;
 pub mod names;
+pub mod parallel;
 pub mod plan;
 pub mod polylines;
 pub mod preset;

@@ -56,6 +56,7 @@ use roadmap::{PathMetrics, Planner, PlannerKind};
 use serde_json::json;
 use std::fmt::Write as _;
 use std::io::Write as _;
+use std::num::NonZeroUsize;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -79,6 +80,9 @@ pub struct OfficeSetup {
     /// Point spacing of the `pointcloud` backend, metres (default: a quarter of the robot
     /// radius).
     pub sample_spacing: Option<Real>,
+    /// Seeds run at once (default: one per core; the output but for the times does not depend
+    /// on it).
+    pub threads: Option<NonZeroUsize>,
 }
 
 impl Default for OfficeSetup {
@@ -91,6 +95,7 @@ impl Default for OfficeSetup {
             backends: Vec::new(),
             jsonl: None,
             sample_spacing: None,
+            threads: None,
         }
     }
 }
@@ -493,8 +498,9 @@ pub fn run(args: &OfficeSetup, progress: &dyn Progress) -> Result<()> {
         .iter()
         .filter(|b| args.backends.is_empty() || args.backends.contains(&b.0))
         .collect();
+    let threads = crate::parallel::threads_or_cores(args.threads);
     let started = Instant::now();
-    // Every cell; with `jsonl`, one JSON line per run written to it as the runs go.
+    // Every cell; with `jsonl`, one JSON line per run written to it as each cell ends.
     let run_cells = |mut jsonl: Option<&mut dyn std::io::Write>| -> Result<Vec<Vec<Cell>>> {
         let mut cells: Vec<Vec<Cell>> = planners.iter().map(|_| Vec::new()).collect();
         let bar = progress.bar((planners.len() * backends.len()) as u64 * args.seeds, "runs");
@@ -502,28 +508,21 @@ pub fn run(args: &OfficeSetup, progress: &dyn Progress) -> Result<()> {
             let map = map_from_patches(&p, patches.clone(), backend, args.sample_spacing)
                 .with_context(|| format!("building the `{backend}` map"))?;
             for (i, row) in planners.iter().enumerate() {
-                let mut runs = Vec::new();
-                let mut cannot = None;
-                for seed in 0..args.seeds {
-                    bar.inc(1);
+                // The seeds on all cores; lines and metrics joined in seed order, so the output
+                // does not depend on the thread count.
+                let seeds = usize::try_from(args.seeds).context("too many seeds")?;
+                let want_lines = jsonl.is_some();
+                let done = crate::parallel::map_in_order(seeds, threads, |seed| {
+                    let seed = seed as u64;
                     let mut planner = match roadmap::named_planner_on(row.kind, &map, space, seed)
                         .map_err(anyhow::Error::from)
                     {
                         Ok(planner) => planner,
                         Err(reason) => {
-                            if let Some(out) = &mut jsonl {
-                                let line = skipped_row(
-                                    &p,
-                                    row.kind,
-                                    map.backend(),
-                                    Mode::Roi,
-                                    seed,
-                                    &reason,
-                                );
-                                writeln!(out, "{line}")?;
-                            }
-                            cannot = Some(format!("{reason:#}"));
-                            continue;
+                            let line = want_lines.then(|| {
+                                skipped_row(&p, row.kind, map.backend(), Mode::Roi, seed, &reason)
+                            });
+                            return (line, Err(format!("{reason:#}")));
                         }
                     };
                     let outcome =
@@ -532,7 +531,7 @@ pub fn run(args: &OfficeSetup, progress: &dyn Progress) -> Result<()> {
                         (0..p.goals.len()).map(|g| planner.path_to(g)).collect();
                     let all: Option<Vec<Vec<Point3>>> = paths.iter().cloned().collect();
                     let metrics = all.map(|paths| RunMetrics::of(outcome.1, &paths));
-                    if let Some(out) = &mut jsonl {
+                    let line = want_lines.then(|| {
                         let mut line = run_row(
                             &p,
                             planner.as_ref() as &dyn Planner,
@@ -551,9 +550,21 @@ pub fn run(args: &OfficeSetup, progress: &dyn Progress) -> Result<()> {
                             line["steep_ratio"] = json!(steep_ratio(m.steep, m.turns));
                             line["curviness_deg"] = json!(m.curviness_deg);
                         }
+                        line
+                    });
+                    (line, Ok(metrics))
+                });
+                bar.inc(args.seeds);
+                let mut runs = Vec::new();
+                let mut cannot = None;
+                for (line, run) in done {
+                    if let (Some(out), Some(line)) = (&mut jsonl, line) {
                         writeln!(out, "{line}")?;
                     }
-                    runs.push(metrics);
+                    match run {
+                        Ok(metrics) => runs.push(metrics),
+                        Err(reason) => cannot = Some(reason),
+                    }
                 }
                 cells[i].push(match cannot {
                     Some(reason) if runs.is_empty() => Cell::Cannot(reason),

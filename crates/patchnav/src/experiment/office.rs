@@ -40,6 +40,10 @@ pub struct OfficeArgs {
     /// radius).
     #[arg(long = "sample-spacing")]
     pub sample_spacing: Option<Real>,
+    /// Seeds run at once (default: one per core; the tables but for the times do not depend on
+    /// it).
+    #[arg(long)]
+    pub threads: Option<std::num::NonZeroUsize>,
 }
 
 impl OfficeArgs {
@@ -53,6 +57,7 @@ impl OfficeArgs {
             backends: self.backends.clone(),
             jsonl: self.jsonl.clone(),
             sample_spacing: self.sample_spacing,
+            threads: self.threads,
         }
     }
 }

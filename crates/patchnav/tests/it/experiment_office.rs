@@ -162,3 +162,47 @@ fn office_marks_planners_that_cannot_run_and_reports_a_missing_problem() {
     assert!(err.starts_with("error: ") && err.contains("nowhere.json"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+/// The seeds run on all cores; the runs' lines (but for their times) and the tables' counts are
+/// those of one thread.
+#[test]
+fn any_thread_count_gives_the_same_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let problem = write_room(dir.path());
+    let run = |threads: &str| {
+        let jsonl = dir.path().join(format!("runs-{threads}.jsonl"));
+        let o = patchnav(&[
+            "experiment",
+            "office",
+            "--problem",
+            problem.to_str().unwrap(),
+            "--seeds",
+            "6",
+            "--planners",
+            "rrt,prm,ma-rrt",
+            "--backends",
+            "polygon,bbox6d",
+            "--max-iterations",
+            "20000",
+            "--threads",
+            threads,
+            "--jsonl",
+            jsonl.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let lines: Vec<serde_json::Value> = std::fs::read_to_string(&jsonl)
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+                v.as_object_mut().unwrap().retain(|k, _| !k.contains("time"));
+                v
+            })
+            .collect();
+        lines
+    };
+    let one = run("1");
+    assert_eq!(one.len(), 3 * 2 * 6);
+    assert_eq!(run("2"), one);
+    assert_eq!(run("5"), one);
+}
