@@ -310,8 +310,8 @@ pub fn write_viewer_mcap(
     header: &Header,
 ) -> Result<ViewerSummary> {
     let (bytes, summary) = viewer_mcap(content, header)?;
-    pointcloud::io::write_bytes_atomically(path, bytes)
-        .with_context(|| format!("writing {}", path.display()))?;
+    // The writer's error names the file.
+    pointcloud::io::write_bytes_atomically(path, bytes)?;
     Ok(summary)
 }
 

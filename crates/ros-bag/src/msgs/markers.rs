@@ -4,7 +4,8 @@
 //! `builtin_interfaces` types inside them.
 //!
 //! CDR only: ROS 1's `Marker` lacks the texture and mesh-file fields, so these types are not
-//! written to ROS 1 bags ([`super::definition`] has no ROS 1 text for them).
+//! written to ROS 1 bags ([`crate::BagWriter::add_topic`] gives them no ROS 1 definition, and
+//! [`crate::BagWriter::write_markers`] refuses a ROS 1 bag).
 //!
 //! ```
 //! use ros_bag::msgs::markers::{ColorRgba, Marker, MarkerArray, TRIANGLE_LIST};
