@@ -154,3 +154,23 @@ def test_plan_writes_map_roadmap_and_path(tmp_path, map_file):
     first, last = path.points[0], path.points[-1]
     assert (first.x, first.y, first.z) == pytest.approx((1.0, 1.0, 0.5))
     assert ((last.x - 9) ** 2 + (last.y - 9) ** 2 + (last.z - 0.5) ** 2) ** 0.5 <= 0.5 + 1e-9
+
+
+def test_a_hybrid_map_has_one_marker_per_patch_kind(tmp_path):
+    out = tmp_path / "hybrid.pmap"
+    run("map", "build", "--scene", "lab", "--kind", "hybrid", "--backend", "polygon", "--out", out)
+    # A polygon map counts the triangles of its trimesh patches only.
+    info = dict(line.split(":", 1) for line in run("map", "info", out).splitlines())
+    assert int(info["planar patches"]) > 0 and int(info["trimesh patches"]) > 0
+    mcap = tmp_path / "hybrid.mcap"
+    run("map", "export", out, "--mcap", mcap)
+    ((topic, schema, msg),) = decode(mcap)
+    assert (topic, schema) == ("/patchnav/map", MARKER_ARRAY)
+    check_markers(msg, "map")
+    by_ns = {m.ns: m for m in msg.markers}
+    assert sorted(by_ns) == ["planar", "trimesh"]
+    assert [m.id for m in msg.markers] == [0, 1]
+    assert all(m.type == TRIANGLE_LIST for m in msg.markers)
+    assert len(by_ns["trimesh"].points) == 3 * int(info["triangles"])
+    # Every planar patch gives at least one triangle.
+    assert len(by_ns["planar"].points) >= 3 * int(info["planar patches"])
