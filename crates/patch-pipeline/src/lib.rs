@@ -22,6 +22,8 @@
 //! * [`plan`]: one planning run on a map ([`plan::plan_on_map`]), as `patchnav plan` and the
 //!   Python package run it.
 //! * [`polylines`]: roadmaps and paths as OBJ polylines.
+//! * [`viewer`]: maps, roadmaps, paths and clouds as ROS 2 markers and clouds in an MCAP file
+//!   that Foxglove and RViz replay.
 //! * [`experiment`]: the thesis's experiments beside its numbers (the lab's §6.1 in
 //!   [`experiment::lab`]).
 //! * [`report`]: the self-contained HTML page drawn from those results.
@@ -62,6 +64,7 @@ pub mod run_config;
 pub mod scene_map;
 pub mod terrain;
 pub mod tof;
+pub mod viewer;
 
 pub use preset::SensorPreset;
 pub use progress::{Progress, Silent, Ticker};

@@ -7,7 +7,8 @@
 //! patchnav extract SCANS...|BAG --out MAP [--topic T] [--sensor alrf|range-camera|structured-light|exact] [--hybrid] [--export F.obj|F.ply]
 //! patchnav map build INPUT --backend polygon|bbox6d|trimesh|rapier|pointcloud --out MAP
 //! patchnav map info MAP
-//! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K]
+//! patchnav map export MAP --mcap OUT.mcap [--cloud CLOUD] [--frame-id map]
+//! patchnav plan MAP --start x,y,z --goal x,y,z --radius R [--planner ...] [--seed K] [--mcap OUT.mcap]
 //! patchnav plan --problem P.json --backend B --planner X --mode explore|solve|roi
 //! patchnav experiment office|lab-timing|lab-volume ...
 //! ```

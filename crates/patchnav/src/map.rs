@@ -1,4 +1,5 @@
-//! `patchnav map build INPUT --backend B --out MAP` and `patchnav map info MAP`.
+//! `patchnav map build INPUT --backend B --out MAP`, `patchnav map info MAP` and
+//! `patchnav map export MAP --mcap OUT.mcap` (a viewer file, [`patch_pipeline::viewer`]).
 //!
 //! `--backend`: `polygon`, `bbox6d`, `trimesh`, `rapier` (from a mesh or a patch map) or
 //! `pointcloud` (from a point cloud or a point-cloud map).
@@ -33,6 +34,7 @@ use patch_map::{
     planar_patches_from_mesh,
 };
 use patch_pipeline::files::{box_text, open_map, save_map, save_patches};
+use patch_pipeline::viewer::{ViewerContent, viewer_header, write_viewer_mcap};
 use pointcloud::Aabb;
 use pointcloud::io::{self, Format};
 use std::fs::File;
@@ -53,6 +55,29 @@ pub enum MapCommand {
         /// A map file written by `patchnav map build`.
         file: PathBuf,
     },
+    /// Write a map (and a cloud) as ROS 2 messages in an MCAP file that Foxglove or RViz
+    /// replays: patches as triangle-list markers, one colour per patch kind.
+    Export(ExportArgs),
+}
+
+/// Arguments of `patchnav map export`.
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// A map file written by `patchnav map build` (any backend; a point-cloud map's points
+    /// become a PointCloud2).
+    pub map: PathBuf,
+    /// The MCAP file to write: the map on /patchnav/map (MarkerArray) or /patchnav/map_points
+    /// (PointCloud2), the cloud on /patchnav/cloud (PointCloud2).
+    #[arg(long)]
+    pub mcap: PathBuf,
+    /// Also write this point cloud (in the map's frame; a sensor pose it carries is applied).
+    #[arg(long)]
+    pub cloud: Option<PathBuf>,
+    /// The frame the messages are in.
+    #[arg(long, default_value = patch_pipeline::viewer::DEFAULT_FRAME_ID)]
+    pub frame_id: String,
+    #[command(flatten)]
+    pub input_options: InputArgs,
 }
 
 /// Arguments of `patchnav map build`.
@@ -224,7 +249,21 @@ pub fn run(command: &MapCommand, progress: &Progress) -> Result<()> {
             print!("{}", describe(file)?);
             Ok(())
         }
+        MapCommand::Export(args) => export(args, progress),
     }
+}
+
+fn export(args: &ExportArgs, progress: &Progress) -> Result<()> {
+    let map = open_map(&args.map)?;
+    let cloud = match &args.cloud {
+        Some(path) => Some(crate::input::read_cloud(path, &args.input_options)?.to_world()),
+        None => None,
+    };
+    let content = ViewerContent { map: Some(&map), cloud: cloud.as_ref(), ..Default::default() };
+    let header = viewer_header(Some(&args.frame_id));
+    let summary = write_viewer_mcap(&args.mcap, &content, &header)?;
+    progress.say(format!("{}: {summary}", args.mcap.display()));
+    Ok(())
 }
 
 fn is_map_file(path: &Path) -> bool {
@@ -705,6 +744,36 @@ mod tests {
         println!("raw {floor:.4} / {raw_over:.4}, carved {carved:.4} / {carved_over:.4}");
         assert!(carved <= floor + 0.002, "carved unsafe {carved:.4} vs floor {floor:.4}");
         assert!(carved_over <= 0.8 * raw_over, "overcautious {carved_over:.4} vs {raw_over:.4}");
+    }
+
+    #[test]
+    fn export_writes_a_viewer_file_of_a_map_and_a_cloud() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = |n: &str| dir.path().join(n).to_str().unwrap().to_owned();
+        std::fs::write(path("f.obj"), "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nf 1 2 3 4\n").unwrap();
+        std::fs::write(path("c.xyz"), "1 1 1\n2 2 2\n").unwrap();
+        let build =
+            ["map", "build", &path("f.obj"), "--backend", "polygon", "--out", &path("f.pmap")];
+        run(&cli(&build).unwrap(), &Progress::new(true)).unwrap();
+        let export = ["map", "export", &path("f.pmap"), "--mcap", &path("f.mcap")];
+        let cloud = path("c.xyz");
+        let with_cloud = [&export[..], &["--cloud", &cloud, "--frame-id", "odom"]].concat();
+        run(&cli(&with_cloud).unwrap(), &Progress::new(true)).unwrap();
+        let bag = ros_bag::Bag::open(path("f.mcap")).unwrap();
+        let info = ros_bag::BagInfo::of(&bag).unwrap();
+        let topics: Vec<_> =
+            info.topics.iter().map(|t| (t.topic.as_str(), t.type_name.as_str(), t.count)).collect();
+        assert_eq!(
+            topics,
+            [
+                ("/patchnav/cloud", "sensor_msgs/PointCloud2", 1),
+                ("/patchnav/map", "visualization_msgs/MarkerArray", 1)
+            ]
+        );
+        assert!(cli(&export[..3]).is_err(), "--mcap is required");
+        let missing = ["map", "export", &path("none.pmap"), "--mcap", &path("x.mcap")];
+        let e = run(&cli(&missing).unwrap(), &Progress::new(true)).unwrap_err();
+        assert!(format!("{e:#}").contains("none.pmap"));
     }
 
     #[test]

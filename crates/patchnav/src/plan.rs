@@ -1,6 +1,7 @@
 //! `patchnav plan MAP --start x,y,z --goal x,y,z --planner rrt|prm|prm-valid|prm-star|lazy-prm|rrt-star|rrt-connect|evasion-rrt|ma-prm|ma-rrt ...`: one planning run on a
 //! map file, printing the status, the counters and the path, and writing the roadmap and the
-//! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens.
+//! path as OBJ polylines (`v` and `l` records) that any 3D viewer opens, or the map, roadmap
+//! and paths as ROS 2 markers in an MCAP file (`--mcap`, [`patch_pipeline::viewer`]).
 
 use crate::names;
 use crate::progress::Progress;
@@ -9,6 +10,7 @@ use clap::Args;
 use patch_core::{Point3, Real};
 use patch_pipeline::plan::{PlanSetup, plan_on_map};
 use patch_pipeline::polylines::{write_obj_lines, write_obj_roadmap};
+use patch_pipeline::viewer::{ViewerContent, viewer_header, write_viewer_mcap};
 use roadmap::{PathMetrics, PlannerKind};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -53,6 +55,14 @@ pub struct PlanArgs {
     /// Write the path to the first goal as an OBJ polyline.
     #[arg(long, conflicts_with = "problem")]
     pub path_out: Option<PathBuf>,
+    /// Write the map, the roadmap and the paths (one per goal reached) as ROS 2 markers in an
+    /// MCAP file that Foxglove or RViz replays (/patchnav/map, /patchnav/roadmap,
+    /// /patchnav/path).
+    #[arg(long, conflicts_with = "problem")]
+    pub mcap: Option<PathBuf>,
+    /// With --mcap: the frame the messages are in.
+    #[arg(long, default_value = patch_pipeline::viewer::DEFAULT_FRAME_ID, requires = "mcap")]
+    pub frame_id: String,
     /// Also shortcut every path (greedy pass and 100 random attempts) and report it.
     #[arg(long, conflicts_with = "problem")]
     pub shortcut: bool,
@@ -155,6 +165,18 @@ pub fn run(args: &PlanArgs, progress: &Progress) -> Result<()> {
         let path = outcome.paths[0].clone().unwrap_or_default();
         let line = (!path.is_empty()).then(|| (0..path.len()).collect());
         write_obj_lines(file, &path, line.into_iter())?;
+    }
+    if let Some(file) = &args.mcap {
+        let paths: Vec<Vec<Point3>> =
+            outcome.paths.iter().map(|p| p.clone().unwrap_or_default()).collect();
+        let content = ViewerContent {
+            map: Some(&map),
+            roadmap: Some(&outcome.roadmap),
+            paths: Some(&paths),
+            cloud: None,
+        };
+        let summary = write_viewer_mcap(file, &content, &viewer_header(Some(&args.frame_id)))?;
+        writeln!(out, "{}: {summary}", file.display())?;
     }
     progress.say(out.trim_end());
     Ok(())

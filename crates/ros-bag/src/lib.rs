@@ -9,10 +9,12 @@
 //!   (a depth `sensor_msgs/Image` with its `sensor_msgs/CameraInfo`, [`image`]),
 //!   [`MessageRef::transforms`] (`tf2_msgs/TFMessage`), [`MessageRef::header`].
 //! * [`BagInfo::of`]: topics, types, counts, time span and frames.
-//! * [`read_scans`]: the clouds (or depth images) of a topic, picked by time window, count or motion, each posed
-//!   in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`], interpolated) or a
-//!   trajectory; [`for_each_scan`] hands them over one at a time.
-//! * [`BagWriter`]: small MCAP and ROS 1 bags of clouds and transforms (fixtures and tests).
+//! * [`read_scans`]: the clouds (or depth images) of a topic, picked by time window, count or
+//!   motion, each posed in a fixed frame by the bag's `/tf` and `/tf_static` ([`TfTree`],
+//!   interpolated) or a trajectory; [`for_each_scan`] hands them over one at a time.
+//! * [`BagWriter`]: small MCAP and ROS 1 bags of clouds and transforms (fixtures and tests),
+//!   and in MCAP `visualization_msgs/MarkerArray`s ([`msgs::markers`]) that RViz and
+//!   Foxglove draw.
 //!
 //! # Crates and what is written here
 //! MCAP is read and written by the `mcap` crate (its streaming reader, with zstd and lz4

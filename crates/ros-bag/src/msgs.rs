@@ -1,6 +1,9 @@
 //! The message types this crate decodes and encodes: `std_msgs/Header`,
 //! `sensor_msgs/PointCloud2`, `sensor_msgs/LaserScan` and `tf2_msgs/TFMessage`, in either
-//! [`Encoding`] (depth images and camera infos are in [`crate::image`]).
+//! [`Encoding`] (depth images and camera infos are in [`crate::image`]);
+//! `visualization_msgs/Marker` and `MarkerArray` in CDR ([`markers`]).
+
+pub mod markers;
 
 use crate::wire::{Encoding, Reader, WireError, Writer};
 use pointcloud::io::pointcloud2::{PointCloud2, PointField};
@@ -12,6 +15,10 @@ pub const POINT_CLOUD2: &str = "sensor_msgs/PointCloud2";
 pub const LASER_SCAN: &str = "sensor_msgs/LaserScan";
 /// `tf2_msgs/TFMessage` (on `/tf` and `/tf_static`).
 pub const TF_MESSAGE: &str = "tf2_msgs/TFMessage";
+/// `visualization_msgs/Marker` (CDR only, [`markers::Marker`]).
+pub const MARKER: &str = "visualization_msgs/Marker";
+/// `visualization_msgs/MarkerArray` (CDR only, [`markers::MarkerArray`]).
+pub const MARKER_ARRAY: &str = "visualization_msgs/MarkerArray";
 
 /// A type name without ROS 2's `/msg/` (`sensor_msgs/msg/PointCloud2` → `sensor_msgs/PointCloud2`).
 pub fn normalise_type(name: &str) -> String {
@@ -336,8 +343,19 @@ const SEPARATOR: &str =
 
 /// The message definition text (ROS 2 `ros2msg` or ROS 1 `.msg` with its dependencies, in
 /// the encoding's own `std_msgs/Header`) and the ROS 1 MD5 sum of the types this crate writes.
+/// The markers have a ROS 2 text only (their MD5 sum is empty).
 pub(crate) fn definition(type_name: &str, encoding: Encoding) -> Option<(String, &'static str)> {
+    let marker_body;
     let (body, md5) = match type_name {
+        MARKER | MARKER_ARRAY if encoding == Encoding::Ros1 => return None,
+        MARKER => (markers::MARKER_DEFINITION, ""),
+        MARKER_ARRAY => {
+            marker_body = format!(
+                "visualization_msgs/Marker[] markers\n{SEPARATOR}MSG: visualization_msgs/Marker\n{}",
+                markers::MARKER_DEFINITION
+            );
+            (marker_body.as_str(), "")
+        }
         POINT_CLOUD2 => (
             concat!(
                 "std_msgs/Header header\nuint32 height\nuint32 width\nPointField[] fields\n",
@@ -415,4 +433,50 @@ pub(crate) fn definition(type_name: &str, encoding: Encoding) -> Option<(String,
         ),
     };
     Some((format!("{body}{SEPARATOR}{header}"), md5))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The `MSG:` sections of a definition, in order.
+    fn sections(text: &str) -> Vec<&str> {
+        text.lines().filter_map(|l| l.strip_prefix("MSG: ")).collect()
+    }
+
+    #[test]
+    fn marker_definitions_name_every_nested_type_once() {
+        let (array, md5) = definition(MARKER_ARRAY, Encoding::Cdr).unwrap();
+        assert!(md5.is_empty());
+        assert!(array.starts_with("visualization_msgs/Marker[] markers\n"));
+        let names = sections(&array);
+        let expected = [
+            "visualization_msgs/Marker",
+            "geometry_msgs/Pose",
+            "geometry_msgs/Point",
+            "geometry_msgs/Quaternion",
+            "geometry_msgs/Vector3",
+            "std_msgs/ColorRGBA",
+            "builtin_interfaces/Duration",
+            "sensor_msgs/CompressedImage",
+            "visualization_msgs/UVCoordinate",
+            "visualization_msgs/MeshFile",
+            "std_msgs/Header",
+            "builtin_interfaces/Time",
+        ];
+        assert_eq!(names, expected);
+        // Every section is preceded by the 80-character separator line.
+        assert_eq!(array.matches(SEPARATOR).count(), expected.len());
+        let (marker, _) = definition(MARKER, Encoding::Cdr).unwrap();
+        assert!(marker.starts_with("int32 ARROW=0\n"));
+        assert_eq!(sections(&marker), expected[1..]);
+        // Every field type the Marker names has its section (or is a primitive).
+        let primitive = ["bool", "int32", "uint32", "float32", "float64", "string", "uint8"];
+        for line in array.lines().filter(|l| !l.starts_with("MSG: ") && !l.starts_with('=')) {
+            let ty = line.split_whitespace().next().unwrap().trim_end_matches("[]");
+            assert!(primitive.contains(&ty) || names.contains(&ty), "{line}");
+        }
+        assert!(definition(MARKER, Encoding::Ros1).is_none());
+        assert!(definition(MARKER_ARRAY, Encoding::Ros1).is_none());
+    }
 }

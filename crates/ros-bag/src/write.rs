@@ -8,6 +8,7 @@
 
 use crate::bag::BagFormat;
 use crate::error::BagError;
+use crate::msgs::markers::MarkerArray;
 use crate::msgs::{self, Header, PointCloud2Msg, TransformStamped};
 use crate::wire::Encoding;
 use pointcloud::io::pointcloud2::PointCloud2;
@@ -62,8 +63,9 @@ impl BagWriter {
         self.format.encoding()
     }
 
-    /// Adds a topic of a type (`sensor_msgs/PointCloud2`, `tf2_msgs/TFMessage`; other types
-    /// get an empty definition).
+    /// Adds a topic of a type (`sensor_msgs/PointCloud2`, `sensor_msgs/LaserScan`,
+    /// `tf2_msgs/TFMessage`, and in MCAP `visualization_msgs/Marker` and `MarkerArray`, with
+    /// their full definitions; other types get an empty definition).
     pub fn add_topic(&mut self, name: &str, type_name: &str) -> Result<TopicId, BagError> {
         let encoding = self.encoding();
         let (definition, md5) = msgs::definition(type_name, encoding).unwrap_or_default();
@@ -134,6 +136,23 @@ impl BagWriter {
     ) -> Result<(), BagError> {
         let data = msgs::encode_tf(transforms, self.encoding());
         self.write(topic, log_time_ns, &data)
+    }
+
+    /// Writes a `MarkerArray` recorded at `log_time_ns`.
+    ///
+    /// # Errors
+    /// [`BagError::Write`] in a ROS 1 bag (markers are written in CDR only) or for an unknown
+    /// topic.
+    pub fn write_markers(
+        &mut self,
+        topic: TopicId,
+        log_time_ns: u64,
+        markers: &MarkerArray,
+    ) -> Result<(), BagError> {
+        if self.encoding() != Encoding::Cdr {
+            return Err(write_error("markers are written to MCAP (CDR) bags only"));
+        }
+        self.write(topic, log_time_ns, &markers.encode())
     }
 
     /// The bag's bytes.
