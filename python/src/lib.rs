@@ -2,7 +2,7 @@
 //! `patch-pipeline` and the library crates, numpy arrays in and out.
 //!
 //! Every function checks its arrays (shape, finiteness) before it calls the libraries, and
-//! turns their errors into the Python exceptions of `patchnav.errors` (see [`errors`]). Long
+//! turns their errors into the Python exceptions of `patchnav.errors` (module `errors`). Long
 //! calls (reading, extraction, map building, collision queries, planning, terrain and ToF
 //! filtering) release the GIL.
 
