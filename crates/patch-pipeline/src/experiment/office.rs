@@ -81,7 +81,8 @@ pub struct OfficeSetup {
     /// radius).
     pub sample_spacing: Option<Real>,
     /// Seeds run at once (default: one per core; the output but for the times does not depend
-    /// on it).
+    /// on it). Each run's time is measured while the other threads run theirs; the timing
+    /// table is cleanest with one thread.
     pub threads: Option<NonZeroUsize>,
 }
 

@@ -41,7 +41,7 @@ pub struct OfficeArgs {
     #[arg(long = "sample-spacing")]
     pub sample_spacing: Option<Real>,
     /// Seeds run at once (default: one per core; the tables but for the times do not depend on
-    /// it).
+    /// it). Each run is timed while the others run: use 1 for the cleanest Table 5.3 times.
     #[arg(long)]
     pub threads: Option<std::num::NonZeroUsize>,
 }
