@@ -281,24 +281,10 @@ pub(crate) fn tof_filter<'py>(
             .with_intensity(image(i, "intensity")?)
             .map_err(|e| invalid(py, format!("{e}")))?;
     }
-    let setup = FilterSetup {
-        frame: FrameSource { range: None, amplitude: None, confidence: None, meta: meta_path },
-        cloud: None,
-        method,
-        at,
-        aat,
-        calibration: None,
-        unwrap,
-        low_at,
-        radial,
-        clamp_corners: None,
-        range2: None,
-        amplitude2: None,
-        meta2: None,
-        max_range: 29.5,
-        phase_noise: sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD,
-        min_amplitude: None,
-    };
+    let frame_source =
+        FrameSource { range: None, amplitude: None, confidence: None, meta: meta_path };
+    let setup =
+        FilterSetup { at, aat, unwrap, low_at, radial, ..FilterSetup::new(frame_source, method) };
     let (output, name) = py
         .detach(|| filter_loaded(&frame, &meta, &setup))
         .map_err(|e| from_anyhow(py, Kind::Tof, &e))?;

@@ -95,6 +95,32 @@ pub struct FilterSetup {
     pub min_amplitude: Option<Real>,
 }
 
+impl FilterSetup {
+    /// The command line's defaults for `frame` filtered by `method`: AT 160, the sidecar's
+    /// AAT and illumination, no unwrapping, depth ranges, corners untested, and the SR-3000's
+    /// two-frequency limits (29.5 m, its phase noise) without a second frame.
+    pub fn new(frame: FrameSource, method: Method) -> FilterSetup {
+        FilterSetup {
+            frame,
+            cloud: None,
+            method,
+            at: 160.0,
+            aat: None,
+            calibration: None,
+            unwrap: false,
+            low_at: None,
+            radial: false,
+            clamp_corners: None,
+            range2: None,
+            amplitude2: None,
+            meta2: None,
+            max_range: 29.5,
+            phase_noise: sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD,
+            min_amplitude: None,
+        }
+    }
+}
+
 /// Reads the frame `args` names (PNG pair or `cloud`) and its sidecar.
 ///
 /// # Errors

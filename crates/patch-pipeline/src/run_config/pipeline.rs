@@ -483,28 +483,17 @@ fn plan(
 /// simulation, the wrapped, unwrapped-correctly and wrong percentages are unknown (NaN; `null`
 /// in `results.json`, a dash in the report).
 fn tof(t: &TofConfig, files: &mut Files, write_3d: bool) -> Result<TofSection> {
+    let frame = FrameSource {
+        range: Some(t.range.clone()),
+        amplitude: Some(t.amplitude.clone()),
+        confidence: t.confidence.clone(),
+        meta: t.meta.clone(),
+    };
     let setup = FilterSetup {
-        frame: FrameSource {
-            range: Some(t.range.clone()),
-            amplitude: Some(t.amplitude.clone()),
-            confidence: t.confidence.clone(),
-            meta: t.meta.clone(),
-        },
-        cloud: None,
-        method: t.method,
-        at: 160.0,
         aat: t.aat,
-        calibration: None,
         unwrap: t.unwrap,
         low_at: t.low_at,
-        radial: false,
-        clamp_corners: None,
-        range2: None,
-        amplitude2: None,
-        meta2: None,
-        max_range: 29.5,
-        phase_noise: sensor_tof::two_freq::SR3000_PHASE_NOISE_RAD,
-        min_amplitude: None,
+        ..FilterSetup::new(frame, t.method)
     };
     let out_path = files.path("tof-cloud.ply");
     let t0 = Instant::now();
