@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::{
     ClosestPoint, Contact, SegmentDistance, TriangleFrame, closest_point_on_region,
-    first_contact_region, segment_region_distance,
+    first_contact_region, segment_region_distance, segment_region_within,
 };
 use crate::step::Step;
 use crate::{
@@ -377,6 +377,20 @@ impl PlanarPatch {
         SegmentDistance { point: self.world_from_patch * s.point, ..s }
     }
 
+    /// Whether the segment `a → b` comes within `radius` of the patch: the answer of
+    /// `segment_distance(a, b).distance <= radius`, with early rejects by the plane and the
+    /// polygon's bounding rectangle ([`segment_region_within`]).
+    pub fn segment_within(&self, a: &Point3, b: &Point3, radius: Real) -> bool {
+        let bounds = self.polygon.bounds2();
+        segment_region_within(
+            &self.polygon,
+            Some(&bounds),
+            &self.to_local(a),
+            &self.to_local(b),
+            radius,
+        )
+    }
+
     /// The first contact of a sphere of radius `radius` swept from `a` to `b`
     /// ([`first_contact_region`]); the normal is the plane normal, flipped as
     /// [`StepHit`](crate::StepHit) describes.
@@ -725,8 +739,13 @@ impl Patch {
 
     /// Whether the step collides with this patch: the distance of its core segment is at most
     /// its radius (touching counts).
+    /// The same answer as `segment_distance(..).distance <= radius`, found with early exits.
     pub fn collides_with<S: Step>(&self, step: &S) -> bool {
-        self.segment_distance(&step.start(), &step.end()).distance <= step.radius()
+        let (a, b, r) = (step.start(), step.end(), step.radius());
+        match self {
+            Patch::Planar(q) => q.segment_within(&a, &b, r),
+            Patch::Trimesh(m) => m.triangle_frames().any(|f| f.segment_within(&a, &b, r)),
+        }
     }
 
     /// The first contact of the step with this patch ([`Patch::first_contact`]).

@@ -1,6 +1,6 @@
-//! Nearest-neighbour queries of the roadmap's k-d structure (RRT's hot path): the
-//! allocation-free `nearest` beside the general `k_nearest(q, 1, ∞)` it replaces, on 10,000 and
-//! 100,000 random vertices in a 12 × 9 × 4 m box (seeded), with random queries.
+//! The roadmap's k-d structure (RRT's hot path): `nearest` and `k_nearest(q, 1, ∞)` on 10,000
+//! and 100,000 random vertices in a 12 × 9 × 4 m box (seeded), with random queries, and
+//! growing the structure to those sizes (`add`).
 //!
 //! Run with `cargo bench -p patchnav-roadmap --bench nn -- --warm-up-time 1 --measurement-time 3`.
 
@@ -46,6 +46,22 @@ fn nearest(c: &mut Criterion) {
                 qs.iter()
                     .map(|q| nn.k_nearest(black_box(q), 1, Real::INFINITY)[0].index)
                     .sum::<usize>()
+            })
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("add");
+    group.sample_size(10);
+    for n in [10_000, 100_000] {
+        group.throughput(Throughput::Elements(n as u64));
+        let all = points(n, 1);
+        group.bench_with_input(BenchmarkId::new("add", n), &all, |b, all| {
+            b.iter(|| {
+                let mut nn = KdNeighbors::new();
+                for p in all {
+                    nn.add(black_box(*p));
+                }
+                nn.len()
             })
         });
     }

@@ -61,7 +61,8 @@ pub struct PlannerCounters {
     /// Capsule checks asked of the map (unspecific or specific), including the start and goal
     /// validity checks.
     pub collision_checks: u64,
-    /// Wall-clock time spent inside those checks.
+    /// Wall-clock time spent inside those checks, estimated from every 16th check (reading
+    /// the clock around each would cost as much as a check on a small map).
     pub collision_time: Duration,
     /// Closest-patch queries ([`ProximityQuery::closest_patch`]) asked of the map: those of the
     /// medial-axis retraction of [`MaPrm`](crate::MaPrm) and [`MaRrt`](crate::MaRrt)
@@ -102,12 +103,41 @@ pub trait Planner {
     fn clear(&mut self);
 }
 
-/// Capsule checks through the map, counted and timed.
+/// Every this many checks one is timed; [`PlannerCounters::collision_time`] scales up.
+const TIME_EVERY: u64 = 16;
+
+/// Capsule checks through the map, counted, and timed by sampling every
+/// [`TIME_EVERY`]th.
 pub(crate) struct Checker<'a, M: ?Sized> {
     map: &'a M,
     radius: Real,
     checks: u64,
+    /// The summed time of the timed checks.
     time: Duration,
+}
+
+impl<M: ?Sized> Checker<'_, M> {
+    /// Runs one check on the map, counted, and timed if it is a sampled one.
+    fn timed<T>(&mut self, check: impl FnOnce(&M) -> T) -> T {
+        let sampled = self.checks.is_multiple_of(TIME_EVERY);
+        self.checks += 1;
+        if !sampled {
+            return check(self.map);
+        }
+        let t0 = Instant::now();
+        let out = check(self.map);
+        self.time += t0.elapsed();
+        out
+    }
+
+    /// The estimated time of all checks: the timed ones scaled to the count.
+    fn estimated_time(&self) -> Duration {
+        let timed = self.checks.div_ceil(TIME_EVERY);
+        if timed == 0 {
+            return Duration::ZERO;
+        }
+        self.time.mul_f64(self.checks as f64 / timed as f64)
+    }
 }
 
 impl<'a, M: UnspecificStepIntersector + ?Sized> Checker<'a, M> {
@@ -121,11 +151,7 @@ impl<'a, M: UnspecificStepIntersector + ?Sized> Checker<'a, M> {
         let Ok(step) = CapsuleStep::new(*a, *b, self.radius) else {
             return false;
         };
-        let t0 = Instant::now();
-        let free = self.map.is_step_free(&step);
-        self.time += t0.elapsed();
-        self.checks += 1;
-        free
+        self.timed(|map| map.is_step_free(&step))
     }
 }
 
@@ -146,10 +172,7 @@ impl<'a, M: SpecificStepIntersector + ?Sized> Checker<'a, M> {
         let Ok(step) = CapsuleStep::new(*a, *b, self.radius) else {
             return Contact::Invalid;
         };
-        let t0 = Instant::now();
-        let hit = self.map.first_hit(&step);
-        self.time += t0.elapsed();
-        self.checks += 1;
+        let hit = self.timed(|map| map.first_hit(&step));
         hit.map_or(Contact::Free, Contact::Hit)
     }
 
@@ -234,7 +257,7 @@ impl Solution {
             vertices: self.graph.node_count(),
             goals_reached: self.goals_reached(),
             goals_total: self.goals.len(),
-            elapsed: started.elapsed(),
+            started,
         }
     }
 
@@ -243,7 +266,7 @@ impl Solution {
         self.counters.vertices = self.graph.node_count();
         self.counters.edges = self.graph.edge_count();
         self.counters.collision_checks = checker.checks;
-        self.counters.collision_time = checker.time;
+        self.counters.collision_time = checker.estimated_time();
     }
 
     /// The final status; `connected(v)` tells whether vertex `v` is connected to the start.

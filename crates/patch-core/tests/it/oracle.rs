@@ -9,7 +9,8 @@ use patch_core::conformance::SceneKind;
 use patch_core::conformance::strategies::{self, probe_step, scene_bounds};
 use patch_core::geometry::{
     PlanarRegion, closest_point_on_region, closest_points_segment_segment, first_contact_region,
-    first_contact_triangle, segment_region_distance, segment_triangle_intersection,
+    first_contact_triangle, segment_region_distance, segment_region_within,
+    segment_triangle_intersection,
 };
 use patch_core::{
     BruteForceMap, CapsuleStep, FromPatches, Patch, PlanarPatch, Point2, Point3, Polygon,
@@ -89,6 +90,39 @@ proptest! {
         let at = a + (b - a) * k.t;
         prop_assert!(((at - k.point).norm() - k.distance).abs() <= ROUND);
         prop_assert!(closest_point_on_region(&poly, &k.point).distance <= ROUND);
+    }
+
+    #[test]
+    fn segment_region_within_answers_as_the_distance(
+        poly in strategies::polygon(),
+        a in local_point(),
+        b in local_point(),
+        flat in 0usize..4,
+        r in 0.0..2.0,
+        at_distance in any::<bool>(),
+    ) {
+        // One case in four lies in the plane, one in four parallel to it; half the radii are
+        // the distance itself (touching), where an early exit must not change the answer.
+        let (a, b) = match flat {
+            0 => (Point3::new(a.x, a.y, 0.0), Point3::new(b.x, b.y, 0.0)),
+            1 => (a, Point3::new(b.x, b.y, a.z)),
+            _ => (a, b),
+        };
+        let d = segment_region_distance(&poly, &a, &b).distance;
+        let r = if at_distance { d } else { r };
+        let bounds = poly.bounds2();
+        for bounds in [None, Some(&bounds)] {
+            prop_assert_eq!(segment_region_within(&poly, bounds, &a, &b, r), d <= r, "d {} r {}", d, r);
+        }
+        let patch = Patch::Planar(PlanarPatch::new(poly.clone(), patch_core::Isometry3::translation(0.3, -1.0, 2.0)).unwrap());
+        let shift = patch_core::Vector3::new(0.3, -1.0, 2.0);
+        let (wa, wb) = (a + shift, b + shift);
+        let wd = patch.segment_distance(&wa, &wb).distance;
+        let wr = if at_distance { wd } else { r };
+        let collides = CapsuleStep::new(wa, wb, wr).map(|step| patch.collides_with(&step));
+        if let Ok(collides) = collides {
+            prop_assert_eq!(collides, wd <= wr);
+        }
     }
 
     #[test]
