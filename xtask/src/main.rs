@@ -23,6 +23,9 @@
 //!   OMPL + FCL planners, OctoMap and PCL segmentation built from `compare/` beside ours on the
 //!   same inputs in one run, ratios ours/theirs; JSONL rows to `target/compare/`
 //!   (docs/comparison.md).
+//! * `cargo xtask voxel-world [--seed S] [--out DIR]`: the generated city-like voxel world
+//!   (more than 100,000 triangles, mixed patch sizes) as OBJ and planning problem
+//!   (docs/performance.md).
 
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
@@ -34,6 +37,7 @@ mod docs;
 mod fixtures;
 mod peers;
 mod provenance;
+mod voxel_world;
 
 const USAGE: &str = "\
 usage: cargo xtask <command>
@@ -60,6 +64,8 @@ commands:
   compare [planning|mapsize|segmentation|all] [--install] [--seeds N] [--poses N]
           [--lab-frames N] [--real-dir D]
                                         OMPL+FCL, OctoMap, PCL (built from compare/) beside ours
+  voxel-world [--seed S] [--out D]      a generated city of voxels (mixed patch sizes, >100k
+                                        triangles) as OBJ + planning problem, for the planners
 ";
 
 fn main() -> ExitCode {
@@ -103,6 +109,7 @@ fn try_main() -> Result<()> {
         "docs" => docs::run(rest),
         "peers" => peers::run(rest),
         "compare" => compare::run(rest),
+        "voxel-world" => voxel_world::run(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
             Ok(())

@@ -93,7 +93,7 @@ impl NearestNeighbors for LinearNeighbors {
 }
 
 /// Points a leaf holds before it splits.
-const LEAF: usize = 12;
+const LEAF: usize = 24;
 
 /// One point of a [`KdNeighbors`] leaf.
 #[derive(Copy, Clone, Debug)]
@@ -154,7 +154,7 @@ impl Best {
     }
 }
 
-/// Exact nearest neighbours in one k-d tree grown by insertion: leaves of up to 12 points
+/// Exact nearest neighbours in one k-d tree grown by insertion: leaves of up to 24 points
 /// split at the median of their widest coordinate, and a subtree whose larger child holds
 /// more than ¾ of its points is rebuilt balanced (the scapegoat rule), once it has doubled
 /// since it was last built. Splits put equal coordinates on one side and choose the widest
@@ -555,7 +555,7 @@ mod proptests {
             for p in &points {
                 kd.add(*p);
             }
-            // A balanced tree of 12-point leaves has depth about log2(n / 12) + 1 ≈ 12;
+            // A balanced tree of 24-point leaves has depth about log2(n / 24) + 1 ≈ 11;
             // the scapegoat rule allows a constant factor.
             assert!(kd.depth() <= 40, "{name}: depth {}", kd.depth());
             let q = points[points.len() / 3] + patch_core::Vector3::new(0.001, 0.0, 0.0);

@@ -42,6 +42,7 @@ pub mod patches;
 mod scene;
 pub mod sensors;
 pub mod shapes;
+pub mod voxel;
 
 pub use builders::{
     HoughClass, TerrainClass, TerrainSpec, TerrainTruth, lab, office, office_floorplan,
