@@ -18,7 +18,10 @@
 //! query per check (L5552–5554).
 //!
 //! The points live in a [`KdForest<6>`]: static k-d trees of power-of-two sizes (the
-//! logarithmic method), so adding a patch is amortised O(log² P).
+//! logarithmic method), so adding a patch is amortised O(log² P). Each inner node of a tree
+//! also keeps the union of the patch boxes below it, and a query skips a subtree whose union
+//! misses the step's box: the same candidates, but on maps of tens of thousands of patches of
+//! mixed sizes 4× faster than the 6D range pruning alone (docs/performance.md).
 //!
 //! # Proximity
 //! With a finite `max_dist`, the candidates are the patches whose boxes meet the cube of half
