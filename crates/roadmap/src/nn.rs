@@ -107,22 +107,22 @@ struct Entry {
 enum Node {
     /// Points with `p[dim] < split` are in `children[0]`, the others in `children[1]`.
     Inner {
-        dim: usize,
         split: Real,
         children: [u32; 2],
-        /// Points below this node.
-        size: usize,
+        /// Points below this node (saturating: it only steers rebalancing).
+        size: u32,
         /// `size` when this node was last built; it is rebuilt only after doubling.
-        built: usize,
+        built: u32,
+        dim: u8,
     },
     Leaf(Vec<Entry>),
 }
 
 impl Node {
-    fn size(&self) -> usize {
+    fn size(&self) -> u32 {
         match self {
             Node::Inner { size, .. } => *size,
-            Node::Leaf(entries) => entries.len(),
+            Node::Leaf(entries) => u32::try_from(entries.len()).unwrap_or(u32::MAX),
         }
     }
 }
@@ -266,7 +266,8 @@ impl KdNeighbors {
                 continue;
             };
             let children = [self.alloc(), self.alloc()];
-            let size = hi - lo;
+            let size = u32::try_from(hi - lo).unwrap_or(u32::MAX);
+            let dim = dim as u8; // 0, 1 or 2
             self.nodes[slot as usize] = Node::Inner { dim, split, children, size, built: size };
             todo.push((children[0], lo, lo + left));
             todo.push((children[1], lo + left, hi));
@@ -297,16 +298,17 @@ impl KdNeighbors {
                 }
             }
             Node::Inner { dim, split, children, .. } => {
-                let diff = q[*dim] - split;
+                let dim = usize::from(*dim);
+                let diff = q[dim] - split;
                 let (near, far) = if diff < 0.0 { (0, 1) } else { (1, 0) };
                 self.nearest_below(children[near], q, rd, offsets, best);
-                let old = offsets[*dim];
+                let old = offsets[dim];
                 let far_rd = rd - old * old + diff * diff;
                 // The slack covers the rounding of `far_rd`, so ties are never pruned.
                 if far_rd <= best.0 * (1.0 + 1e-12) {
-                    offsets[*dim] = diff;
+                    offsets[dim] = diff;
                     self.nearest_below(children[far], q, far_rd, offsets, best);
-                    offsets[*dim] = old;
+                    offsets[dim] = old;
                 }
             }
         }
@@ -321,7 +323,8 @@ impl KdNeighbors {
                 }
             }
             Node::Inner { dim, split, children, .. } => {
-                let diff = q[*dim] - split;
+                let dim = usize::from(*dim);
+                let diff = q[dim] - split;
                 let (near, far) = if diff < 0.0 { (0, 1) } else { (1, 0) };
                 self.k_nearest_below(children[near], q, best);
                 if diff * diff <= best.bound() {
@@ -394,9 +397,9 @@ impl NearestNeighbors for KdNeighbors {
         let leaf_len = loop {
             match &mut self.nodes[at as usize] {
                 Node::Inner { dim, split, children, size, .. } => {
-                    *size += 1;
+                    *size = size.saturating_add(1);
                     self.path.push(at);
-                    at = children[usize::from(e.p[*dim] >= *split)];
+                    at = children[usize::from(e.p[usize::from(*dim)] >= *split)];
                 }
                 Node::Leaf(entries) => {
                     entries.push(e);
@@ -412,7 +415,8 @@ impl NearestNeighbors for KdNeighbors {
         let scapegoat = self.path.iter().copied().find(|&n| match &self.nodes[n as usize] {
             Node::Inner { children, size, built, .. } => {
                 let heavier = children.iter().map(|&c| self.nodes[c as usize].size()).max();
-                *size >= 2 * built && heavier.unwrap_or(0) * 4 > size * 3
+                let (size, built) = (u64::from(*size), u64::from(*built));
+                size >= 2 * built && u64::from(heavier.unwrap_or(0)) * 4 > size * 3
             }
             Node::Leaf(_) => false,
         });
