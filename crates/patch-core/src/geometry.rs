@@ -412,8 +412,16 @@ pub fn segment_region_within<R: PlanarRegion + ?Sized>(
     if [a, b].iter().any(|p| p.z.abs() <= radius && region.contains(&p.xy())) {
         return true;
     }
+    // An edge whose box in the plane misses the segment's box grown by `reach` is farther
+    // than `radius` (the margin again covers rounding): skip it before the exact test.
+    let (lo_x, hi_x) = (a.x.min(b.x) - reach, a.x.max(b.x) + reach);
+    let (lo_y, hi_y) = (a.y.min(b.y) - reach, a.y.max(b.y) + reach);
     region.edges().any(|(e0, e1)| {
-        closest_points_segment_segment(a, b, &lift(&e0), &lift(&e1)).distance <= radius
+        e0.x.max(e1.x) >= lo_x
+            && e0.x.min(e1.x) <= hi_x
+            && e0.y.max(e1.y) >= lo_y
+            && e0.y.min(e1.y) <= hi_y
+            && closest_points_segment_segment(a, b, &lift(&e0), &lift(&e1)).distance <= radius
     })
 }
 

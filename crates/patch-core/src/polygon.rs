@@ -48,12 +48,20 @@ pub struct Bounds2 {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ring {
     points: Vec<Point2>,
+    /// The rectangle of `points`, kept so point-in-polygon tests skip rings they lie
+    /// outside of.
+    bounds: Bounds2,
 }
 
 impl Ring {
     /// The heap bytes this ring owns (its vertex buffer, by capacity).
     pub fn heap_bytes(&self) -> usize {
         self.points.capacity() * std::mem::size_of::<Point2>()
+    }
+
+    /// The bounding rectangle of the vertices.
+    pub fn bounds2(&self) -> Bounds2 {
+        self.bounds
     }
 
     /// The vertices, in ring order (the closing edge from the last to the first is implied).
@@ -181,7 +189,10 @@ impl Polygon {
             }
             // Tight buffers: maps hold many patches, and their memory is reported exactly.
             points.shrink_to_fit();
-            Ring { points }
+            let (min, max) = points[1..]
+                .iter()
+                .fold((points[0], points[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+            Ring { points, bounds: Bounds2 { min, max } }
         });
         let outer = rings.next().expect("the outer ring is always present");
         let mut holes: Vec<Ring> = rings.collect();
@@ -240,13 +251,7 @@ impl Polygon {
 
     /// The bounding rectangle (that of the outer ring).
     pub fn bounds2(&self) -> Bounds2 {
-        let mut min = self.outer.points[0];
-        let mut max = min;
-        for p in &self.outer.points[1..] {
-            min = min.inf(p);
-            max = max.sup(p);
-        }
-        Bounds2 { min, max }
+        self.outer.bounds
     }
 
     /// Whether `p` lies in the closed polygon: inside the outer ring and not strictly inside any
@@ -264,6 +269,12 @@ impl Polygon {
         }
         let mut winding = 0;
         for ring in self.rings() {
+            // Outside a ring's rectangle a point is outside the ring and not on it: it adds
+            // nothing to the winding number (and outside the outer ring's, it is outside).
+            let b = &ring.bounds;
+            if p.x < b.min.x || p.x > b.max.x || p.y < b.min.y || p.y > b.max.y {
+                continue;
+            }
             match ring_winding_or_boundary(&ring.points, p) {
                 None => return true,
                 Some(w) => winding += w,
