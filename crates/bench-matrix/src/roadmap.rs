@@ -331,7 +331,7 @@ impl Termination for Checkpoints {
             if progress.iterations < next {
                 break;
             }
-            self.seconds.push(progress.elapsed.as_secs_f64());
+            self.seconds.push(progress.elapsed().as_secs_f64());
         }
         self.seconds.len() == self.at.len()
     }

@@ -589,6 +589,9 @@ pub(crate) fn earlier(t: Real, gap: Real, t_best: Real, gap_best: Real) -> bool 
 }
 
 /// A patch of a map: planar or triangle mesh.
+// Most patches are planar, and the queries read them in place: boxing the larger variant would
+// add a pointer chase to every collision test to save memory on the rarer meshes.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Patch {
