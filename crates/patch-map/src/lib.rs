@@ -47,21 +47,25 @@
 //! # Which one to pick
 //! Measured on the benchmark matrix (`docs/benchmarks.md`: the office floor plan, the lab's
 //! exact geometry and the lab's four maps built from scans; every backend on the same map in
-//! one run):
-//! * RRT, PRM and their relatives (they ask "is this step free?") on a map that does not
-//!   change: [`RapierMap`] (feature `rapier`, on by default). It is the fastest or within 1.2×
-//!   of the fastest on every scene of the matrix: RRT to the office's four goals 485 µs against
-//!   bbox6d's 404 µs; RRT, 500 iterations, on the lab's hybrid map from scans 1.84 ms against
-//!   trimesh's 2.17 ms, bbox6d's 9.62 ms and polygon's 11.0 ms. Without the feature,
-//!   [`TrimeshMap`]: within 1.25× of the fastest, except on whole-scan meshes (the `trimesh`
-//!   map kind), where it is 2.5× (RRT) to 4.7× (PRM) slower than rapier.
+//! one run) and on the generated voxel world (docs/performance.md). No backend is the fastest
+//! everywhere; each pick below is within 1.5× of the fastest on the scenes it names:
+//! * RRT, PRM and their relatives (they ask "is this step free?") on a map of a few hundred
+//!   planar patches (rooms, floor plans): [`BBox6dMap`]. Office, median time to the four goals
+//!   (`patchnav experiment office --seeds 10 --planners rrt,prm,evasion-rrt --threads 1`):
+//!   RRT 219 µs against polygon's 281 µs, trimesh's 342 µs and rapier's 540 µs; PRM 13.4 ms
+//!   against 15.7, 22.5 and 19.8 ms.
+//! * The same planners on maps built from scans, with trimesh patches or whole-scan meshes:
+//!   [`RapierMap`] (feature `rapier`, on by default), or [`TrimeshMap`] without the feature.
+//!   RRT, 500 iterations, on the lab's hybrid map from scans: rapier 1.84 ms, trimesh 2.17 ms,
+//!   bbox6d 9.62 ms, polygon 11.0 ms (the matrix's run before the patch backends' faster
+//!   capsule test, which gains them about 1.4× on such maps); on whole-scan meshes trimesh is
+//!   2.5× (RRT) to 4.7× (PRM) slower than rapier.
 //! * Large finished maps (tens of thousands of patches): [`TrimeshMap`]. On the generated
 //!   voxel world (`cargo xtask voxel-world`: 38,293 patches of very mixed sizes, 120,932
 //!   triangles) RRT takes 1.82 µs per iteration on it, 3.15 µs on [`BBox6dMap`] and 5.19 µs
-//!   on [`RapierMap`] (docs/performance.md), so rapier's lead on the matrix's smaller scenes
-//!   does not carry over.
+//!   on [`RapierMap`].
 //! * The Evasion RRT (it asks for the first contact of a step): [`BBox6dMap`] or [`PolygonMap`].
-//!   Office: 1.63 and 1.54 ms; trimesh 5.79 ms, rapier 6.39 ms.
+//!   Office: 1.78 and 1.69 ms; trimesh 7.81 ms, rapier 9.83 ms.
 //! * Maps that grow while the robot explores (patches added between queries): [`BBox6dMap`];
 //!   adding stays exact and sublinear. Its k-d nodes keep the union of the patch boxes below
 //!   them, so maps of mixed patch sizes stay fast, but a large patch's box still makes it a
