@@ -37,11 +37,18 @@ pub trait PlanarRegion {
 
     /// Every boundary edge, as `(from, to)`.
     fn edges(&self) -> impl Iterator<Item = (Point2, Point2)> + '_;
+
+    /// The bounding rectangle of the region.
+    fn bounds2(&self) -> crate::Bounds2;
 }
 
 impl PlanarRegion for Polygon {
     fn contains(&self, p: &Point2) -> bool {
         Polygon::contains(self, p)
+    }
+
+    fn bounds2(&self) -> crate::Bounds2 {
+        Polygon::bounds2(self)
     }
 
     fn edges(&self) -> impl Iterator<Item = (Point2, Point2)> + '_ {
@@ -86,6 +93,10 @@ impl PlanarRegion for Triangle2 {
 
     fn edges(&self) -> impl Iterator<Item = (Point2, Point2)> + '_ {
         (0..3).map(move |i| (self.vertices[i], self.vertices[(i + 1) % 3]))
+    }
+
+    fn bounds2(&self) -> crate::Bounds2 {
+        crate::Bounds2::of(&self.vertices)
     }
 }
 
@@ -371,12 +382,11 @@ pub fn segment_region_distance<R: PlanarRegion + ?Sized>(
 ///
 /// Two rejects come first, each by a margin far above rounding (`1e-9` relative), so they never
 /// change the answer: both ends on one side of the plane and farther than `radius` from it, or
-/// the segment's box in the plane farther than `radius` from `bounds` (the region's bounding
-/// rectangle, if given). The exact test then stops at the first part of the region within
-/// `radius`, instead of measuring them all.
+/// the segment's box in the plane farther than `radius` from the region's
+/// [`bounds2`](PlanarRegion::bounds2). The exact test then stops at the first part of the region
+/// within `radius`, instead of measuring them all.
 pub fn segment_region_within<R: PlanarRegion + ?Sized>(
     region: &R,
-    bounds: Option<&crate::Bounds2>,
     a: &Point3,
     b: &Point3,
     radius: Real,
@@ -386,13 +396,12 @@ pub fn segment_region_within<R: PlanarRegion + ?Sized>(
     if (a.z > reach && b.z > reach) || (a.z < -reach && b.z < -reach) {
         return false;
     }
-    if let Some(r) = bounds {
-        let gap = |lo: Real, hi: Real, min: Real, max: Real| (min - hi).max(lo - max);
-        if gap(a.x.min(b.x), a.x.max(b.x), r.min.x, r.max.x) > reach
-            || gap(a.y.min(b.y), a.y.max(b.y), r.min.y, r.max.y) > reach
-        {
-            return false;
-        }
+    let r = region.bounds2();
+    let gap = |lo: Real, hi: Real, min: Real, max: Real| (min - hi).max(lo - max);
+    if gap(a.x.min(b.x), a.x.max(b.x), r.min.x, r.max.x) > reach
+        || gap(a.y.min(b.y), a.y.max(b.y), r.min.y, r.max.y) > reach
+    {
+        return false;
     }
     // What follows is `segment_region_distance`, stopping at the first distance within reach.
     let (a, b) = &snap_to_plane(a, b);
@@ -678,16 +687,7 @@ impl TriangleFrame {
     /// Whether the world segment `a → b` comes within `radius` of the triangle
     /// ([`segment_region_within`]).
     pub fn segment_within(&self, a: &Point3, b: &Point3, radius: Real) -> bool {
-        let v = &self.triangle.vertices;
-        let bounds =
-            crate::Bounds2 { min: v[0].inf(&v[1]).inf(&v[2]), max: v[0].sup(&v[1]).sup(&v[2]) };
-        segment_region_within(
-            &self.triangle,
-            Some(&bounds),
-            &self.to_local(a),
-            &self.to_local(b),
-            radius,
-        )
+        segment_region_within(&self.triangle, &self.to_local(a), &self.to_local(b), radius)
     }
 
     /// The distance between the world segment `a → b` and the triangle (world frame).

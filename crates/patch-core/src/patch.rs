@@ -381,14 +381,7 @@ impl PlanarPatch {
     /// `segment_distance(a, b).distance <= radius`, with early rejects by the plane and the
     /// polygon's bounding rectangle ([`segment_region_within`]).
     pub fn segment_within(&self, a: &Point3, b: &Point3, radius: Real) -> bool {
-        let bounds = self.polygon.bounds2();
-        segment_region_within(
-            &self.polygon,
-            Some(&bounds),
-            &self.to_local(a),
-            &self.to_local(b),
-            radius,
-        )
+        segment_region_within(&self.polygon, &self.to_local(a), &self.to_local(b), radius)
     }
 
     /// The first contact of a sphere of radius `radius` swept from `a` to `b`
@@ -741,8 +734,8 @@ impl Patch {
     }
 
     /// Whether the step collides with this patch: the distance of its core segment is at most
-    /// its radius (touching counts).
-    /// The same answer as `segment_distance(..).distance <= radius`, found with early exits.
+    /// its radius (touching counts). The same answer as `segment_distance(..).distance <=
+    /// radius`, found with early exits.
     pub fn collides_with<S: Step>(&self, step: &S) -> bool {
         let (a, b, r) = (step.start(), step.end(), step.radius());
         match self {

@@ -40,6 +40,15 @@ pub struct Bounds2 {
     pub max: Point2,
 }
 
+impl Bounds2 {
+    /// The rectangle of `points`, which must not be empty (rings and triangles never are).
+    pub(crate) fn of(points: &[Point2]) -> Bounds2 {
+        let (min, max) =
+            points[1..].iter().fold((points[0], points[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+        Bounds2 { min, max }
+    }
+}
+
 /// A closed ring of vertices: the last vertex connects back to the first, which is *not*
 /// repeated at the end.
 ///
@@ -189,10 +198,8 @@ impl Polygon {
             }
             // Tight buffers: maps hold many patches, and their memory is reported exactly.
             points.shrink_to_fit();
-            let (min, max) = points[1..]
-                .iter()
-                .fold((points[0], points[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
-            Ring { points, bounds: Bounds2 { min, max } }
+            let bounds = Bounds2::of(&points);
+            Ring { points, bounds }
         });
         let outer = rings.next().expect("the outer ring is always present");
         let mut holes: Vec<Ring> = rings.collect();
