@@ -106,6 +106,7 @@ pub mod any_map;
 pub mod backend;
 pub mod bbox6d;
 pub mod compare;
+mod compact_mesh;
 pub mod from_mesh;
 pub mod kdtree;
 pub mod mapfile;

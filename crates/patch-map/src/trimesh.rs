@@ -75,13 +75,12 @@ use std::io::{Read, Write};
 
 use parry3d_f64::bounding_volume::{Aabb as BoxAabb, BoundingVolume as _};
 use parry3d_f64::math::Isometry;
-use parry3d_f64::partitioning::BvhNode;
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
 use parry3d_f64::query::{
     DefaultQueryDispatcher, PointQuery as _, QueryDispatcher as _, Ray, RayCast as _,
     ShapeCastOptions,
 };
-use parry3d_f64::shape::{Ball, CompositeShapeRef, Segment, TriMesh, TriMeshFlags, Triangle};
+use parry3d_f64::shape::{Ball, Segment, Triangle};
 use patch_core::geometry::TriangleFrame;
 use patch_core::{
     Aabb, CapsuleStep, FromPatches, LineStep, MapError, Patch, PatchId, PatchKind, PatchMap,
@@ -92,6 +91,7 @@ use patch_core::{
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::Backend;
+use crate::compact_mesh::{CompactMesh, IndexedMesh};
 use crate::mapfile::{MapCounts, MapFileError, read_map, write_map};
 use crate::persist::{MapFile, MemoryUsage, patch_counts, patches_memory_bytes};
 use crate::triangulate::{TriangulationError, triangulate_polygon};
@@ -486,39 +486,38 @@ impl Probe {
     }
 
     /// Whether the probe touches a triangle of the mesh.
-    pub(crate) fn touches_mesh(&self, mesh: &TriMesh) -> bool {
-        mesh.bvh()
-            .leaves(|node: &BvhNode| self.may_touch(&node.aabb()))
-            .any(|tri| self.touches(&mesh.triangle(tri)))
+    pub(crate) fn touches_mesh(&self, mesh: &impl IndexedMesh) -> bool {
+        mesh.any_triangle(|aabb| self.may_touch(aabb), |tri| self.touches(&mesh.triangle(tri)))
     }
 
     /// The first triangle of the mesh the probe touches before `bound`: `(triangle, t)`.
-    pub(crate) fn first_in_mesh(&self, mesh: &TriMesh, bound: Real) -> Option<(u32, Real)> {
-        mesh.bvh().find_best(
+    pub(crate) fn first_in_mesh(&self, mesh: &impl IndexedMesh, bound: Real) -> Option<(u32, Real)> {
+        mesh.find_best(
             bound,
-            |node: &BvhNode, best| self.box_entry(&node.aabb(), best),
+            |aabb, best| self.box_entry(aabb, best),
             |tri, best| self.first_contact(&mesh.triangle(tri), best),
         )
     }
 }
 
 /// The triangle of the mesh nearest to `point`, if closer than `bound`: `(triangle, closest
-/// point, distance)` (parry's point projection with location).
-pub(crate) fn mesh_nearest(
-    mesh: &TriMesh,
-    point: &Point3,
-    bound: Real,
-) -> Option<(u32, Point3, Real)> {
-    let (tri, (proj, _)) =
-        CompositeShapeRef(mesh).project_local_point_and_get_location(point, bound, false)?;
-    let d = (proj.point - point).norm();
-    (d < bound).then_some((tri, proj.point, d))
+/// point, distance)` (best-first over the boxes, parry's point projection on the triangles).
+fn mesh_nearest(mesh: &impl IndexedMesh, point: &Point3, bound: Real) -> Option<(u32, Point3, Real)> {
+    let (tri, (d, q)) = mesh.find_best(
+        bound,
+        |aabb, _| aabb.distance_to_local_point(point, true),
+        |tri, _| {
+            let q = mesh.triangle(tri).project_local_point(point, false).point;
+            Some(((q - point).norm(), q))
+        },
+    )?;
+    Some((tri, q, d))
 }
 
 /// The closest point of a mesh to `point` among the triangles accepted by `keep`, starting
 /// from triangle `first` (which must be accepted): `(triangle, point, distance)`.
 pub(crate) fn closest_on_triangles(
-    mesh: &TriMesh,
+    mesh: &impl IndexedMesh,
     point: &Point3,
     first: u32,
     keep: impl Fn(u32) -> bool,
@@ -528,19 +527,18 @@ pub(crate) fn closest_on_triangles(
         ((q - point).norm(), q)
     };
     let (d0, q0) = project(first);
-    mesh.bvh()
-        .find_best(
-            d0,
-            |node: &BvhNode, _| node.aabb().distance_to_local_point(point, true),
-            |tri, _| keep(tri).then(|| project(tri)),
-        )
-        .map_or((first, q0, d0), |(tri, (d, q))| (tri, q, d))
+    mesh.find_best(
+        d0,
+        |aabb, _| aabb.distance_to_local_point(point, true),
+        |tri, _| keep(tri).then(|| project(tri)),
+    )
+    .map_or((first, q0, d0), |(tri, (d, q))| (tri, q, d))
 }
 
 /// The hit of a step on `patch` at `t`, whose triangles in `mesh` are those accepted by
 /// `keep`; `tri` is one of them touched at `t`.
 pub(crate) fn complete_hit<S: Step>(
-    mesh: &TriMesh,
+    mesh: &impl IndexedMesh,
     tri: u32,
     keep: impl Fn(u32) -> bool,
     id: PatchId,
@@ -568,7 +566,7 @@ pub(crate) fn valid_proximity_query(point: &Point3, max_dist: Real) -> bool {
 /// One immutable mesh and the patch of each of its triangles.
 #[derive(Clone)]
 struct Level {
-    mesh: TriMesh,
+    mesh: CompactMesh,
     patch_of: Vec<PatchId>,
 }
 
@@ -579,9 +577,8 @@ impl Level {
         indices: Vec<[u32; 3]>,
         patch_of: Vec<PatchId>,
     ) -> Option<Level> {
-        // No flags: parry neither merges vertices nor deletes triangles, so triangle `i` of the
-        // mesh is `indices[i]` and `patch_of` stays aligned.
-        let mesh = TriMesh::with_flags(vertices, indices, TriMeshFlags::empty()).ok()?;
+        // The build reorders the triangles and `patch_of` with them.
+        let (mesh, patch_of) = CompactMesh::build(vertices, indices, patch_of)?;
         Some(Level { mesh, patch_of })
     }
 
@@ -607,10 +604,10 @@ impl Level {
         self.patch_of.len()
     }
 
-    /// parry's count of the mesh's heap (vertices, indices and BVH nodes, by capacity) and the
-    /// triangle → patch table.
+    /// The mesh's heap (vertices, indices and BVH nodes, by capacity) and the triangle → patch
+    /// table.
     fn heap_bytes(&self) -> usize {
-        self.mesh.heap_memory_size() + self.patch_of.capacity() * size_of::<PatchId>()
+        self.mesh.heap_bytes() + self.patch_of.capacity() * size_of::<PatchId>()
     }
 }
 
@@ -796,7 +793,7 @@ impl TrimeshMap {
         self.levels.iter().map(Level::len).sum()
     }
 
-    /// The number of parry meshes the triangles are in (1 after building at once or
+    /// The number of meshes the triangles are in (1 after building at once or
     /// [`compact`](Self::compact), at most `log₂ n + 1` after incremental adds; 0 when empty).
     pub fn num_meshes(&self) -> usize {
         self.levels.len()
@@ -812,9 +809,8 @@ impl TrimeshMap {
         })
     }
 
-    /// The heap bytes of the meshes (parry's own count of vertices, indices and BVH nodes from
-    /// their capacities, [`TriMesh::heap_memory_size`]) and of the triangle → patch tables;
-    /// without the patch list.
+    /// The heap bytes of the meshes (vertices, indices and BVH nodes, by capacity) and of the
+    /// triangle → patch tables; without the patch list.
     pub fn mesh_memory_bytes(&self) -> usize {
         self.levels.capacity() * size_of::<Level>()
             + self.levels.iter().map(Level::heap_bytes).sum::<usize>()

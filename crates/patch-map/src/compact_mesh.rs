@@ -1,0 +1,492 @@
+//! A triangle mesh with a compact bounding volume hierarchy: the storage of
+//! [`TrimeshMap`](crate::TrimeshMap) (thesis §5.4.2, the OPCODE role: a BVH over the
+//! triangles of Delaunay-triangulated patches).
+//!
+//! parry's [`TriMesh`] keeps one BVH leaf per triangle with `f64` boxes, about 136 bytes of
+//! hierarchy per triangle. [`CompactMesh`] keeps
+//! * the vertices (`f64`, as given: the narrow phase is exact on them) and one `[u32; 3]` per
+//!   triangle, reordered so the triangles of each leaf are contiguous;
+//! * a binary tree of 32-byte nodes whose boxes are `f32`, rounded outwards (so they still
+//!   contain their triangles), with up to [`LEAF_SIZE`] triangles per leaf.
+//!
+//! Leaves test each triangle's own `f64` box (computed from its vertices) before the exact
+//! test, so pruning is as tight as with one triangle per leaf. The tree is built top-down by
+//! the surface area heuristic over binned centroids; below depth [`SAH_DEPTH`] it splits at the
+//! median, so every tree is at most about 70 levels deep and the walks need no heap.
+//!
+//! Both meshes answer through [`IndexedMesh`], so the trimesh and rapier maps share one narrow
+//! phase.
+
+use parry3d_f64::bounding_volume::Aabb as BoxAabb;
+use parry3d_f64::partitioning::{BvhLeafCost, BvhNode};
+use parry3d_f64::shape::{TriMesh, Triangle};
+use patch_core::{Point3, Real};
+
+/// The most triangles in one leaf.
+pub(crate) const LEAF_SIZE: usize = 4;
+
+/// Below this depth the tree is split by the surface area heuristic, from it on at the median
+/// (which bounds the depth by `SAH_DEPTH + log₂(n)`).
+pub(crate) const SAH_DEPTH: usize = 40;
+
+/// Centroid bins of the surface area heuristic.
+const BINS: usize = 16;
+
+/// The walks' stack: deeper than any tree [`CompactMesh::build`] makes (at most
+/// `SAH_DEPTH + 32` levels for `u32` triangle indices).
+const STACK: usize = 96;
+
+/// Triangles with a bounding volume hierarchy over them, queried by the maps' narrow phase.
+pub(crate) trait IndexedMesh {
+    /// Triangle `i`.
+    fn triangle(&self, i: u32) -> Triangle;
+
+    /// Whether `hit` holds for a triangle whose boxes all pass `visit` (a conservative test: a
+    /// box that fails it holds no triangle `hit` accepts).
+    fn any_triangle(&self, visit: impl Fn(&BoxAabb) -> bool, hit: impl FnMut(u32) -> bool) -> bool;
+
+    /// The triangle of least cost below `max_cost`: `aabb_cost(box, best)` is a lower bound of
+    /// the cost of every triangle in the box (`Real::MAX` if none can beat `best`),
+    /// `leaf_cost(triangle, best)` its cost if below `best`.
+    fn find_best<L: BvhLeafCost>(
+        &self,
+        max_cost: Real,
+        aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
+        leaf_cost: impl Fn(u32, Real) -> Option<L>,
+    ) -> Option<(u32, L)>;
+}
+
+impl IndexedMesh for TriMesh {
+    fn triangle(&self, i: u32) -> Triangle {
+        TriMesh::triangle(self, i)
+    }
+
+    fn any_triangle(&self, visit: impl Fn(&BoxAabb) -> bool, hit: impl FnMut(u32) -> bool) -> bool {
+        self.bvh().leaves(|node: &BvhNode| visit(&node.aabb())).any(hit)
+    }
+
+    fn find_best<L: BvhLeafCost>(
+        &self,
+        max_cost: Real,
+        aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
+        leaf_cost: impl Fn(u32, Real) -> Option<L>,
+    ) -> Option<(u32, L)> {
+        self.bvh().find_best(max_cost, |node: &BvhNode, best| aabb_cost(&node.aabb(), best), leaf_cost)
+    }
+}
+
+/// A node: an `f32` box rounded outwards; a leaf holds triangles `first..first + count`, an
+/// inner node (`count == 0`) has its children at `first` and `first + 1`.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: [f32; 3],
+    max: [f32; 3],
+    first: u32,
+    count: u32,
+}
+
+impl Node {
+    fn aabb(&self) -> BoxAabb {
+        BoxAabb::new(self.min.map(Real::from).into(), self.max.map(Real::from).into())
+    }
+}
+
+/// The largest `f32` not above `x`.
+fn down(x: Real) -> f32 {
+    let f = x as f32;
+    if Real::from(f) > x { f.next_down() } else { f }
+}
+
+/// The smallest `f32` not below `x`.
+fn up(x: Real) -> f32 {
+    let f = x as f32;
+    if Real::from(f) < x { f.next_up() } else { f }
+}
+
+/// Triangles (by index into `f64` vertices) and a compact BVH over them; see the
+/// [module docs](self).
+#[derive(Clone, Debug)]
+pub(crate) struct CompactMesh {
+    vertices: Vec<Point3>,
+    indices: Vec<[u32; 3]>,
+    nodes: Vec<Node>,
+}
+
+/// A triangle's box and centroid during the build.
+#[derive(Clone, Copy)]
+struct Item {
+    min: [Real; 3],
+    max: [Real; 3],
+    centroid: [Real; 3],
+}
+
+/// A box under construction.
+#[derive(Clone, Copy)]
+struct Bounds {
+    min: [Real; 3],
+    max: [Real; 3],
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds { min: [Real::INFINITY; 3], max: [Real::NEG_INFINITY; 3] };
+
+    fn add_box(&mut self, min: &[Real; 3], max: &[Real; 3]) {
+        for k in 0..3 {
+            self.min[k] = self.min[k].min(min[k]);
+            self.max[k] = self.max[k].max(max[k]);
+        }
+    }
+
+    fn add_point(&mut self, p: &[Real; 3]) {
+        self.add_box(p, p);
+    }
+
+    /// Half the surface area (the heuristic's measure); 0 when empty.
+    fn half_area(&self) -> Real {
+        let d = [0, 1, 2].map(|k| (self.max[k] - self.min[k]).max(0.0));
+        d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+    }
+}
+
+impl CompactMesh {
+    /// The mesh of `indices` into `vertices`, with `tags[i]` belonging to triangle `i`; the
+    /// triangles (and the tags with them) are reordered by the tree. `None` if there are no
+    /// triangles. Every index must be below `vertices.len()`.
+    pub(crate) fn build<T>(
+        vertices: Vec<Point3>,
+        indices: Vec<[u32; 3]>,
+        tags: Vec<T>,
+    ) -> Option<(CompactMesh, Vec<T>)> {
+        debug_assert_eq!(indices.len(), tags.len());
+        if indices.is_empty() {
+            return None;
+        }
+        let items: Vec<Item> = indices
+            .iter()
+            .map(|t| {
+                let mut b = Bounds::EMPTY;
+                for &i in t {
+                    let p = &vertices[i as usize];
+                    b.add_point(&[p.x, p.y, p.z]);
+                }
+                let centroid = [0, 1, 2].map(|k| 0.5 * (b.min[k] + b.max[k]));
+                Item { min: b.min, max: b.max, centroid }
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..indices.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * indices.len().div_ceil(LEAF_SIZE));
+        nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+        // (node, range of `order`, depth)
+        let mut work = vec![(0usize, 0usize, indices.len(), 0usize)];
+        while let Some((node, start, end, depth)) = work.pop() {
+            let mut bounds = Bounds::EMPTY;
+            for &i in &order[start..end] {
+                bounds.add_box(&items[i as usize].min, &items[i as usize].max);
+            }
+            nodes[node].min = bounds.min.map(down);
+            nodes[node].max = bounds.max.map(up);
+            let count = end - start;
+            if count <= LEAF_SIZE {
+                nodes[node].first = start as u32;
+                nodes[node].count = count as u32;
+                continue;
+            }
+            let mid = split(&items, &mut order[start..end], depth) + start;
+            let child = nodes.len();
+            nodes[node].first = child as u32;
+            nodes[node].count = 0;
+            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+            work.push((child, start, mid, depth + 1));
+            work.push((child + 1, mid, end, depth + 1));
+        }
+        nodes.shrink_to_fit();
+        let indices: Vec<[u32; 3]> = order.iter().map(|&i| indices[i as usize]).collect();
+        let mut tags: Vec<Option<T>> = tags.into_iter().map(Some).collect();
+        let tags = order.iter().map(|&i| tags[i as usize].take().expect("a permutation")).collect();
+        Some((CompactMesh { vertices, indices, nodes }, tags))
+    }
+
+    /// The vertices.
+    pub(crate) fn vertices(&self) -> &[Point3] {
+        &self.vertices
+    }
+
+    /// The triangles, as indices into [`vertices`](Self::vertices), in tree order.
+    pub(crate) fn indices(&self) -> &[[u32; 3]] {
+        &self.indices
+    }
+
+    /// The heap bytes (by capacity).
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.vertices.capacity() * size_of::<Point3>()
+            + self.indices.capacity() * size_of::<[u32; 3]>()
+            + self.nodes.capacity() * size_of::<Node>()
+    }
+
+    /// The `f64` box of triangle `i`.
+    fn triangle_aabb(&self, i: u32) -> BoxAabb {
+        let [a, b, c] = self.indices[i as usize].map(|v| self.vertices[v as usize]);
+        BoxAabb::new(a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+    }
+}
+
+/// Splits `order` (at least two triangles) in place and returns the size of the first part
+/// (never 0 or all): the best of [`BINS`] centroid bins along the longest centroid axis by the
+/// surface area heuristic, or the median below depth [`SAH_DEPTH`] and where the heuristic
+/// finds no split.
+fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
+    let mut cb = Bounds::EMPTY;
+    for &i in order.iter() {
+        cb.add_point(&items[i as usize].centroid);
+    }
+    let extent = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
+    let axis = (0..3).fold(0, |a, k| if extent[k] > extent[a] { k } else { a });
+    let median = |order: &mut [u32]| {
+        let mid = order.len() / 2;
+        order.select_nth_unstable_by(mid, |&x, &y| {
+            items[x as usize].centroid[axis].total_cmp(&items[y as usize].centroid[axis])
+        });
+        mid
+    };
+    if depth >= SAH_DEPTH || !(extent[axis] > 0.0) {
+        return median(order);
+    }
+    let scale = BINS as Real / extent[axis];
+    let bin = |i: u32| {
+        let b = ((items[i as usize].centroid[axis] - cb.min[axis]) * scale) as usize;
+        b.min(BINS - 1)
+    };
+    let mut boxes = [Bounds::EMPTY; BINS];
+    let mut counts = [0usize; BINS];
+    for &i in order.iter() {
+        let b = bin(i);
+        boxes[b].add_box(&items[i as usize].min, &items[i as usize].max);
+        counts[b] += 1;
+    }
+    // Cost of splitting after bin `k`: area × count on each side.
+    let mut right_cost = [0.0; BINS];
+    let (mut acc, mut n) = (Bounds::EMPTY, 0);
+    for k in (1..BINS).rev() {
+        acc.add_box(&boxes[k].min, &boxes[k].max);
+        n += counts[k];
+        right_cost[k - 1] = acc.half_area() * n as Real;
+    }
+    let (mut acc, mut n) = (Bounds::EMPTY, 0);
+    let mut best: Option<(Real, usize)> = None;
+    for k in 0..BINS - 1 {
+        acc.add_box(&boxes[k].min, &boxes[k].max);
+        n += counts[k];
+        if n == 0 || n == order.len() {
+            continue;
+        }
+        let cost = acc.half_area() * n as Real + right_cost[k];
+        if best.is_none_or(|(c, _)| cost < c) {
+            best = Some((cost, k));
+        }
+    }
+    let Some((_, k)) = best else {
+        return median(order);
+    };
+    // Partition: bins 0..=k first.
+    let mut left = 0;
+    for j in 0..order.len() {
+        if bin(order[j]) <= k {
+            order.swap(left, j);
+            left += 1;
+        }
+    }
+    left
+}
+
+impl IndexedMesh for CompactMesh {
+    fn triangle(&self, i: u32) -> Triangle {
+        let [a, b, c] = self.indices[i as usize].map(|v| self.vertices[v as usize]);
+        Triangle::new(a, b, c)
+    }
+
+    fn any_triangle(
+        &self,
+        visit: impl Fn(&BoxAabb) -> bool,
+        mut hit: impl FnMut(u32) -> bool,
+    ) -> bool {
+        let mut stack = [0u32; STACK];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let node = &self.nodes[stack[len] as usize];
+            if !visit(&node.aabb()) {
+                continue;
+            }
+            if node.count == 0 {
+                stack[len] = node.first;
+                stack[len + 1] = node.first + 1;
+                len += 2;
+            } else {
+                for i in node.first..node.first + node.count {
+                    if visit(&self.triangle_aabb(i)) && hit(i) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    fn find_best<L: BvhLeafCost>(
+        &self,
+        max_cost: Real,
+        aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
+        leaf_cost: impl Fn(u32, Real) -> Option<L>,
+    ) -> Option<(u32, L)> {
+        let mut best: Option<(u32, L)> = None;
+        let mut best_cost = max_cost;
+        let root = aabb_cost(&self.nodes[0].aabb(), best_cost);
+        let mut stack = [(0u32, 0.0); STACK];
+        stack[0] = (0, root);
+        let mut len = usize::from(root < best_cost);
+        while len > 0 {
+            len -= 1;
+            let (id, cost) = stack[len];
+            if cost >= best_cost {
+                continue;
+            }
+            let node = &self.nodes[id as usize];
+            if node.count == 0 {
+                let (l, r) = (node.first, node.first + 1);
+                let cl = aabb_cost(&self.nodes[l as usize].aabb(), best_cost);
+                let cr = aabb_cost(&self.nodes[r as usize].aabb(), best_cost);
+                // The nearer child is popped first.
+                let (near, far) = if cl <= cr { ((l, cl), (r, cr)) } else { ((r, cr), (l, cl)) };
+                for (child, c) in [far, near] {
+                    if c < best_cost {
+                        stack[len] = (child, c);
+                        len += 1;
+                    }
+                }
+            } else {
+                for i in node.first..node.first + node.count {
+                    if aabb_cost(&self.triangle_aabb(i), best_cost) >= best_cost {
+                        continue;
+                    }
+                    if let Some(val) = leaf_cost(i, best_cost) {
+                        let c = val.cost();
+                        if c < best_cost {
+                            best_cost = c;
+                            best = Some((i, val));
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parry3d_f64::query::PointQuery as _;
+    use proptest::prelude::*;
+
+    fn mesh(points: &[[Real; 9]]) -> CompactMesh {
+        let vertices = points
+            .iter()
+            .flat_map(|t| [0, 3, 6].map(|k| Point3::new(t[k], t[k + 1], t[k + 2])))
+            .collect();
+        let indices = (0..points.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let tags = (0..points.len()).collect();
+        let (mesh, tags) = CompactMesh::build(vertices, indices, tags).unwrap();
+        // The tags follow their triangles.
+        for (i, &t) in tags.iter().enumerate() {
+            let tri = mesh.triangle(i as u32);
+            assert_eq!(tri.a, Point3::new(points[t][0], points[t][1], points[t][2]));
+        }
+        mesh
+    }
+
+    fn depth(mesh: &CompactMesh, node: u32) -> usize {
+        let n = &mesh.nodes[node as usize];
+        if n.count > 0 { 1 } else { 1 + depth(mesh, n.first).max(depth(mesh, n.first + 1)) }
+    }
+
+    #[test]
+    fn outward_rounding_contains_the_value() {
+        for x in [0.1, -0.1, 1e-40, -1e-40, 1e39, -1e39, 3.0, 16_777_217.0, -16_777_217.0] {
+            assert!(Real::from(down(x)) <= x && x <= Real::from(up(x)), "{x}");
+        }
+    }
+
+    #[test]
+    fn identical_triangles_make_a_shallow_tree() {
+        let mesh = mesh(&vec![[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]; 10_000]);
+        assert!(depth(&mesh, 0) <= 14);
+    }
+
+    fn triangles() -> impl Strategy<Value = Vec<[Real; 9]>> {
+        // Clusters of very different sizes, so the tree has to mix them.
+        prop::collection::vec(
+            (prop::array::uniform3(-50.0..50.0), 0.001..20.0, prop::array::uniform9(0.0..1.0)),
+            1..300,
+        )
+        .prop_map(|v| {
+            v.into_iter()
+                .map(|(c, s, u): ([Real; 3], Real, [Real; 9])| {
+                    std::array::from_fn(|k| c[k % 3] + s * u[k])
+                })
+                .collect()
+        })
+    }
+
+    proptest! {
+        /// Every node's box holds the boxes below it, and every triangle is in one leaf.
+        #[test]
+        fn boxes_hold_their_triangles(tris in triangles()) {
+            let mesh = mesh(&tris);
+            let mut seen = vec![0; tris.len()];
+            let mut stack = vec![(0u32, None::<BoxAabb>)];
+            while let Some((id, parent)) = stack.pop() {
+                let node = &mesh.nodes[id as usize];
+                let b = node.aabb();
+                if let Some(p) = parent {
+                    prop_assert!(p.mins <= b.mins && b.maxs <= p.maxs);
+                }
+                if node.count == 0 {
+                    stack.push((node.first, Some(b)));
+                    stack.push((node.first + 1, Some(b)));
+                } else {
+                    prop_assert!(node.count as usize <= LEAF_SIZE);
+                    for i in node.first..node.first + node.count {
+                        let t = mesh.triangle_aabb(i);
+                        prop_assert!(b.mins <= t.mins && t.maxs <= b.maxs);
+                        seen[i as usize] += 1;
+                    }
+                }
+            }
+            prop_assert!(seen.iter().all(|&s| s == 1));
+        }
+
+        /// The walks answer like a scan of all triangles: nearest centroid below a bound, and
+        /// whether any triangle's box holds a point.
+        #[test]
+        fn walks_answer_like_a_scan(tris in triangles(), q in prop::array::uniform3(-60.0..60.0), bound in 0.0..200.0) {
+            let mesh = mesh(&tris);
+            let q = Point3::from(q);
+            let cost = |i: u32| {
+                let t = mesh.triangle(i);
+                (((t.a.coords + t.b.coords + t.c.coords) / 3.0) - q.coords).norm()
+            };
+            let found = mesh.find_best(
+                bound,
+                |b, _| b.distance_to_local_point(&q, true),
+                |i, best| Some(cost(i)).filter(|&c| c < best),
+            );
+            let scan = (0..tris.len() as u32).map(cost).filter(|&c| c < bound).min_by(Real::total_cmp);
+            prop_assert_eq!(found.map(|f| f.1), scan);
+            let inside = |b: &BoxAabb| b.contains_local_point(&q);
+            let any = mesh.any_triangle(inside, |_| true);
+            let scan = (0..tris.len() as u32).any(|i| inside(&mesh.triangle_aabb(i)));
+            prop_assert_eq!(any, scan);
+        }
+    }
+}
