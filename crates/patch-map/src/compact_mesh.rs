@@ -71,7 +71,11 @@ impl IndexedMesh for TriMesh {
         aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
         leaf_cost: impl Fn(u32, Real) -> Option<L>,
     ) -> Option<(u32, L)> {
-        self.bvh().find_best(max_cost, |node: &BvhNode, best| aabb_cost(&node.aabb(), best), leaf_cost)
+        self.bvh().find_best(
+            max_cost,
+            |node: &BvhNode, best| aabb_cost(&node.aabb(), best),
+            leaf_cost,
+        )
     }
 }
 
@@ -112,12 +116,12 @@ pub(crate) struct CompactMesh {
     nodes: Vec<Node>,
 }
 
-/// A triangle's box and centroid during the build.
+/// A triangle's box (rounded outwards) and centroid during the build.
 #[derive(Clone, Copy)]
 struct Item {
-    min: [Real; 3],
-    max: [Real; 3],
-    centroid: [Real; 3],
+    min: [f32; 3],
+    max: [f32; 3],
+    centroid: [f32; 3],
 }
 
 /// A box under construction.
@@ -130,15 +134,37 @@ struct Bounds {
 impl Bounds {
     const EMPTY: Bounds = Bounds { min: [Real::INFINITY; 3], max: [Real::NEG_INFINITY; 3] };
 
-    fn add_box(&mut self, min: &[Real; 3], max: &[Real; 3]) {
+    fn add_box(&mut self, min: &[f32; 3], max: &[f32; 3]) {
+        // Plain comparisons (the coordinates are finite): faster than `f64::min`.
         for k in 0..3 {
-            self.min[k] = self.min[k].min(min[k]);
-            self.max[k] = self.max[k].max(max[k]);
+            let (lo, hi) = (Real::from(min[k]), Real::from(max[k]));
+            if lo < self.min[k] {
+                self.min[k] = lo;
+            }
+            if hi > self.max[k] {
+                self.max[k] = hi;
+            }
         }
     }
 
     fn add_point(&mut self, p: &[Real; 3]) {
-        self.add_box(p, p);
+        for (k, &x) in p.iter().enumerate() {
+            if x < self.min[k] {
+                self.min[k] = x;
+            }
+            if x > self.max[k] {
+                self.max[k] = x;
+            }
+        }
+    }
+
+    fn add_bounds(&mut self, b: &Bounds) {
+        self.add_point(&b.min);
+        self.add_point(&b.max);
+    }
+
+    fn add_item(&mut self, item: &Item) {
+        self.add_box(&item.min, &item.max);
     }
 
     /// Half the surface area (the heuristic's measure); 0 when empty.
@@ -152,7 +178,7 @@ impl CompactMesh {
     /// The mesh of `indices` into `vertices`, with `tags[i]` belonging to triangle `i`; the
     /// triangles (and the tags with them) are reordered by the tree. `None` if there are no
     /// triangles. Every index must be below `vertices.len()`.
-    pub(crate) fn build<T>(
+    pub(crate) fn build<T: Copy>(
         vertices: Vec<Point3>,
         indices: Vec<[u32; 3]>,
         tags: Vec<T>,
@@ -169,8 +195,8 @@ impl CompactMesh {
                     let p = &vertices[i as usize];
                     b.add_point(&[p.x, p.y, p.z]);
                 }
-                let centroid = [0, 1, 2].map(|k| 0.5 * (b.min[k] + b.max[k]));
-                Item { min: b.min, max: b.max, centroid }
+                let centroid = [0, 1, 2].map(|k| (0.5 * (b.min[k] + b.max[k])) as f32);
+                Item { min: b.min.map(down), max: b.max.map(up), centroid }
             })
             .collect();
         let mut order: Vec<u32> = (0..indices.len() as u32).collect();
@@ -181,7 +207,7 @@ impl CompactMesh {
         while let Some((node, start, end, depth)) = work.pop() {
             let mut bounds = Bounds::EMPTY;
             for &i in &order[start..end] {
-                bounds.add_box(&items[i as usize].min, &items[i as usize].max);
+                bounds.add_item(&items[i as usize]);
             }
             nodes[node].min = bounds.min.map(down);
             nodes[node].max = bounds.max.map(up);
@@ -201,9 +227,28 @@ impl CompactMesh {
             work.push((child + 1, mid, end, depth + 1));
         }
         nodes.shrink_to_fit();
-        let indices: Vec<[u32; 3]> = order.iter().map(|&i| indices[i as usize]).collect();
-        let mut tags: Vec<Option<T>> = tags.into_iter().map(Some).collect();
-        let tags = order.iter().map(|&i| tags[i as usize].take().expect("a permutation")).collect();
+        drop(items);
+        // Triangles in leaf order, and vertices in the order the triangles first use them, so
+        // a walk reads both nearly sequentially (unused vertices are dropped).
+        let mut new_index = vec![u32::MAX; vertices.len()];
+        let mut kept = Vec::with_capacity(vertices.len().min(3 * indices.len()));
+        let indices: Vec<[u32; 3]> = order
+            .iter()
+            .map(|&i| {
+                indices[i as usize].map(|v| {
+                    let slot = &mut new_index[v as usize];
+                    if *slot == u32::MAX {
+                        *slot = kept.len() as u32;
+                        kept.push(vertices[v as usize]);
+                    }
+                    *slot
+                })
+            })
+            .collect();
+        drop(new_index);
+        let mut vertices = kept;
+        vertices.shrink_to_fit();
+        let tags = order.iter().map(|&i| tags[i as usize]).collect();
         Some((CompactMesh { vertices, indices, nodes }, tags))
     }
 
@@ -238,7 +283,7 @@ impl CompactMesh {
 fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     let mut cb = Bounds::EMPTY;
     for &i in order.iter() {
-        cb.add_point(&items[i as usize].centroid);
+        cb.add_point(&items[i as usize].centroid.map(Real::from));
     }
     let extent = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
     let axis = (0..3).fold(0, |a, k| if extent[k] > extent[a] { k } else { a });
@@ -249,33 +294,34 @@ fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
         });
         mid
     };
-    if depth >= SAH_DEPTH || !(extent[axis] > 0.0) {
+    // `extent` is 0 (or NaN, never for finite vertices) when all centroids coincide.
+    if depth >= SAH_DEPTH || extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return median(order);
     }
     let scale = BINS as Real / extent[axis];
     let bin = |i: u32| {
-        let b = ((items[i as usize].centroid[axis] - cb.min[axis]) * scale) as usize;
+        let b = ((Real::from(items[i as usize].centroid[axis]) - cb.min[axis]) * scale) as usize;
         b.min(BINS - 1)
     };
     let mut boxes = [Bounds::EMPTY; BINS];
     let mut counts = [0usize; BINS];
     for &i in order.iter() {
         let b = bin(i);
-        boxes[b].add_box(&items[i as usize].min, &items[i as usize].max);
+        boxes[b].add_item(&items[i as usize]);
         counts[b] += 1;
     }
     // Cost of splitting after bin `k`: area × count on each side.
     let mut right_cost = [0.0; BINS];
     let (mut acc, mut n) = (Bounds::EMPTY, 0);
     for k in (1..BINS).rev() {
-        acc.add_box(&boxes[k].min, &boxes[k].max);
+        acc.add_bounds(&boxes[k]);
         n += counts[k];
         right_cost[k - 1] = acc.half_area() * n as Real;
     }
     let (mut acc, mut n) = (Bounds::EMPTY, 0);
     let mut best: Option<(Real, usize)> = None;
     for k in 0..BINS - 1 {
-        acc.add_box(&boxes[k].min, &boxes[k].max);
+        acc.add_bounds(&boxes[k]);
         n += counts[k];
         if n == 0 || n == order.len() {
             continue;

@@ -105,8 +105,8 @@
 pub mod any_map;
 pub mod backend;
 pub mod bbox6d;
-pub mod compare;
 mod compact_mesh;
+pub mod compare;
 pub mod from_mesh;
 pub mod kdtree;
 pub mod mapfile;

@@ -149,8 +149,12 @@ pub fn write_map<T: Serialize>(
     {
         return Err(MapFileError::BadTag(backend.to_owned()));
     }
-    let body = bincode::serde::encode_to_vec(payload, config())
+    // Two passes, so the body is never held in memory (a map of millions of triangles encodes
+    // to hundreds of MB): the first only counts and checksums the bytes the second writes.
+    let mut digest = Digest { len: 0, crc: crc32fast::Hasher::new() };
+    bincode::serde::encode_into_std_write(payload, &mut digest, config())
         .map_err(|e| MapFileError::Encode(e.to_string()))?;
+    let (body_len, body_crc) = (digest.len, digest.crc.finalize());
     let mut header = Vec::with_capacity(HEADER_LEN);
     header.extend_from_slice(&MAGIC);
     header.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
@@ -160,15 +164,40 @@ pub fn write_map<T: Serialize>(
     for v in [counts.planar_patches, counts.trimesh_patches, counts.triangles, counts.points] {
         header.extend_from_slice(&v.to_le_bytes());
     }
-    header.extend_from_slice(&(body.len() as u64).to_le_bytes());
-    header.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
+    header.extend_from_slice(&body_len.to_le_bytes());
+    header.extend_from_slice(&body_crc.to_le_bytes());
     let header_crc = crc32fast::hash(&header);
     header.extend_from_slice(&header_crc.to_le_bytes());
     debug_assert_eq!(header.len(), HEADER_LEN);
-    writer.write_all(&header)?;
-    writer.write_all(&body)?;
-    writer.flush()?;
-    Ok((HEADER_LEN + body.len()) as u64)
+    let mut out = std::io::BufWriter::new(writer);
+    out.write_all(&header)?;
+    let written = bincode::serde::encode_into_std_write(payload, &mut out, config())
+        .map_err(|e| MapFileError::Encode(e.to_string()))?;
+    if written as u64 != body_len {
+        return Err(MapFileError::Encode(format!(
+            "the payload encoded to {written} bytes, {body_len} the first time"
+        )));
+    }
+    out.flush()?;
+    Ok(HEADER_LEN as u64 + body_len)
+}
+
+/// Counts and checksums the bytes written to it.
+struct Digest {
+    len: u64,
+    crc: crc32fast::Hasher,
+}
+
+impl Write for Digest {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.len += buf.len() as u64;
+        self.crc.update(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// Reads exactly `buf.len()` bytes, or reports how many were there.

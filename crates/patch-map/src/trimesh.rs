@@ -73,7 +73,7 @@
 use std::fmt;
 use std::io::{Read, Write};
 
-use parry3d_f64::bounding_volume::{Aabb as BoxAabb, BoundingVolume as _};
+use parry3d_f64::bounding_volume::Aabb as BoxAabb;
 use parry3d_f64::math::Isometry;
 use parry3d_f64::query::details::closest_points_segment_segment_with_locations_nD;
 use parry3d_f64::query::{
@@ -322,6 +322,32 @@ fn cast_options(max_t: Real) -> ShapeCastOptions {
     }
 }
 
+/// The first time in `[0, max_t]` at which `ray.origin + t ray.dir` is inside the box grown by
+/// `grow` (0 if the origin is inside): the slab test. Equal to parry's `cast_local_ray` on the
+/// grown box with `solid`, without building the grown box.
+fn segment_enters_box(ray: &Ray, aabb: &BoxAabb, grow: Real, max_t: Real) -> Option<Real> {
+    let (mut t0, mut t1): (Real, Real) = (0.0, max_t);
+    for k in 0..3 {
+        let (lo, hi) = (aabb.mins[k] - grow, aabb.maxs[k] + grow);
+        let (o, d) = (ray.origin[k], ray.dir[k]);
+        if d == 0.0 {
+            if o < lo || o > hi {
+                return None;
+            }
+        } else {
+            let inv = 1.0 / d;
+            let (a, b) = ((lo - o) * inv, (hi - o) * inv);
+            let (a, b) = if a <= b { (a, b) } else { (b, a) };
+            t0 = t0.max(a);
+            t1 = t1.min(b);
+            if t0 > t1 {
+                return None;
+            }
+        }
+    }
+    Some(t0)
+}
+
 /// The distance between the segment `a b` and the edge `p q` (parry's closed form).
 fn segment_segment_distance(a: &Point3, b: &Point3, p: &Point3, q: &Point3) -> Real {
     let (la, lb) = closest_points_segment_segment_with_locations_nD((a, b), (p, q));
@@ -376,33 +402,27 @@ impl Probe {
     }
 
     /// Whether the probe may touch something inside the box: conservative, the box is grown
-    /// by [`PRUNE_SLACK`] (parry's slab test can miss a contact exactly on a box face by an ulp).
+    /// by [`PRUNE_SLACK`] (a float slab test can miss a contact exactly on a box face by an ulp).
     pub(crate) fn may_touch(&self, aabb: &BoxAabb) -> bool {
         match self {
-            Probe::Segment { ray, .. } => {
-                aabb.loosened(PRUNE_SLACK).cast_local_ray(ray, 1.0, true).is_some()
-            }
+            Probe::Segment { ray, .. } => segment_enters_box(ray, aabb, PRUNE_SLACK, 1.0).is_some(),
             Probe::Sphere { center, r } => {
                 aabb.distance_to_local_point(center, true) <= r + PRUNE_SLACK
             }
             Probe::Sweep { r, ray, .. } => {
-                aabb.loosened(r + PRUNE_SLACK).cast_local_ray(ray, 1.0, true).is_some()
+                segment_enters_box(ray, aabb, r + PRUNE_SLACK, 1.0).is_some()
             }
         }
     }
 
     /// A lower bound of the first contact time with anything inside the box (grown by
-    /// [`PRUNE_SLACK`]), if below `bound`; `Real::MAX` if none (the convention of parry's
-    /// `find_best`).
+    /// [`PRUNE_SLACK`]), if below `bound`; `Real::MAX` if none (the convention of the
+    /// best-first searches).
     pub(crate) fn box_entry(&self, aabb: &BoxAabb, bound: Real) -> Real {
         let entry = match self {
-            Probe::Segment { ray, .. } => {
-                aabb.loosened(PRUNE_SLACK).cast_local_ray(ray, bound, true)
-            }
+            Probe::Segment { ray, .. } => segment_enters_box(ray, aabb, PRUNE_SLACK, bound),
             Probe::Sphere { .. } => self.may_touch(aabb).then_some(0.0),
-            Probe::Sweep { r, ray, .. } => {
-                aabb.loosened(r + PRUNE_SLACK).cast_local_ray(ray, bound, true)
-            }
+            Probe::Sweep { r, ray, .. } => segment_enters_box(ray, aabb, r + PRUNE_SLACK, bound),
         };
         entry.unwrap_or(Real::MAX)
     }
@@ -491,7 +511,11 @@ impl Probe {
     }
 
     /// The first triangle of the mesh the probe touches before `bound`: `(triangle, t)`.
-    pub(crate) fn first_in_mesh(&self, mesh: &impl IndexedMesh, bound: Real) -> Option<(u32, Real)> {
+    pub(crate) fn first_in_mesh(
+        &self,
+        mesh: &impl IndexedMesh,
+        bound: Real,
+    ) -> Option<(u32, Real)> {
         mesh.find_best(
             bound,
             |aabb, best| self.box_entry(aabb, best),
@@ -502,7 +526,11 @@ impl Probe {
 
 /// The triangle of the mesh nearest to `point`, if closer than `bound`: `(triangle, closest
 /// point, distance)` (best-first over the boxes, parry's point projection on the triangles).
-fn mesh_nearest(mesh: &impl IndexedMesh, point: &Point3, bound: Real) -> Option<(u32, Point3, Real)> {
+fn mesh_nearest(
+    mesh: &impl IndexedMesh,
+    point: &Point3,
+    bound: Real,
+) -> Option<(u32, Point3, Real)> {
     let (tri, (d, q)) = mesh.find_best(
         bound,
         |aabb, _| aabb.distance_to_local_point(point, true),

@@ -214,18 +214,35 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
         let extraction = t0.elapsed().as_secs_f64();
         bar.inc(1);
         let (planar, trimesh, triangles) = patch_counts(&patches)?;
-        for backend in Backend::patch_backends() {
+        built.drawings.push(drawing(kind, &patches));
+        let name = format!("map-{kind}.ply");
+        let (vertices, faces) = patch_mesh(&patches)?;
+        write_mesh_f32(&files.path(&name), &vertices, &faces)?;
+        drop((vertices, faces));
+        files.add(
+            format!(
+                "{kind} map: {planar} planar patches (triangulated) and {trimesh} trimesh \
+                 patches, PLY mesh"
+            ),
+            &name,
+        )?;
+        // The planning backend's map is built last, from the patches themselves, so no other
+        // backend's map (nor a copy of the patches) is alive beside it: the peak is one map.
+        let keep = plan_backend(kind);
+        let mut patches = Some(patches);
+        let mut rows = Vec::new();
+        for backend in Backend::patch_backends().filter(|&b| b != keep).chain([keep]) {
+            let input = if backend == keep { patches.take() } else { patches.clone() };
+            let input = input.context("the kept backend comes last")?;
             let t1 = Instant::now();
-            let map = patch_map(patches.clone(), backend)
+            let map = patch_map(input, backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
             let load = t1.elapsed().as_secs_f64();
-            built.rows.push(patch_map_row(
-                kind,
-                &map,
-                (planar, trimesh, triangles),
-                extraction + load,
-            )?);
-            if backend == plan_backend(kind) {
+            rows.push((
+                backend,
+                patch_map_row(kind, &map, (planar, trimesh, triangles), extraction + load)?,
+            ));
+            if backend == keep {
                 built.maps.push(BuiltMap {
                     kind,
                     map,
@@ -238,17 +255,9 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
             }
             bar.inc(1);
         }
-        built.drawings.push(drawing(kind, &patches));
-        let name = format!("map-{kind}.ply");
-        let (vertices, triangles) = patch_mesh(&patches)?;
-        write_mesh_f32(&files.path(&name), &vertices, &triangles)?;
-        files.add(
-            format!(
-                "{kind} map: {planar} planar patches (triangulated) and {trimesh} trimesh \
-                 patches, PLY mesh"
-            ),
-            &name,
-        )?;
+        // The rows in the backends' order.
+        rows.sort_by_key(|(backend, _)| Backend::ALL.iter().position(|b| b == backend));
+        built.rows.extend(rows.into_iter().map(|(_, row)| row));
     }
     let t0 = Instant::now();
     let points: Vec<Point3> = crate::scene_map::pc_points(&lab.clouds, &Default::default())?;
