@@ -138,7 +138,7 @@ fn config() -> impl bincode::config::Config {
 
 /// Writes `payload` as a map file of `backend` with the given counts; returns the bytes written.
 pub fn write_map<T: Serialize>(
-    mut writer: impl Write,
+    writer: impl Write,
     backend: &str,
     counts: MapCounts,
     payload: &T,
