@@ -2,7 +2,7 @@
 //! [`TrimeshMap`](crate::TrimeshMap) (thesis §5.4.2, the OPCODE role: a BVH over the
 //! triangles of Delaunay-triangulated patches).
 //!
-//! parry's [`TriMesh`] keeps one BVH leaf per triangle with `f64` boxes, about 136 bytes of
+//! parry's `TriMesh` keeps one BVH leaf per triangle with `f64` boxes, about 136 bytes of
 //! hierarchy per triangle. [`CompactMesh`] keeps
 //! * the vertices (`f64`, as given: the narrow phase is exact on them) and one `[u32; 3]` per
 //!   triangle, reordered so the triangles of each leaf are contiguous;
@@ -14,12 +14,16 @@
 //! the surface area heuristic over binned centroids; below depth [`SAH_DEPTH`] it splits at the
 //! median, so every tree is at most about 70 levels deep and the walks need no heap.
 //!
-//! Both meshes answer through [`IndexedMesh`], so the trimesh and rapier maps share one narrow
-//! phase.
+//! The mesh is also a parry [`Shape`] (of type [`ShapeType::Custom`]): the rapier map's
+//! colliders hold it, so both maps store triangles the same compact way and answer through
+//! [`IndexedMesh`] with one narrow phase.
 
-use parry3d_f64::bounding_volume::Aabb as BoxAabb;
-use parry3d_f64::partitioning::{BvhLeafCost, BvhNode};
-use parry3d_f64::shape::{TriMesh, Triangle};
+use parry3d_f64::bounding_volume::{Aabb as BoxAabb, BoundingSphere};
+use parry3d_f64::mass_properties::MassProperties;
+use parry3d_f64::math::{Isometry, Vector};
+use parry3d_f64::partitioning::BvhLeafCost;
+use parry3d_f64::query::{PointProjection, PointQuery, Ray, RayCast, RayIntersection};
+use parry3d_f64::shape::{FeatureId, Shape, ShapeType, Triangle, TypedShape};
 use patch_core::{Point3, Real};
 
 /// The most triangles in one leaf.
@@ -54,29 +58,6 @@ pub(crate) trait IndexedMesh {
         aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
         leaf_cost: impl Fn(u32, Real) -> Option<L>,
     ) -> Option<(u32, L)>;
-}
-
-impl IndexedMesh for TriMesh {
-    fn triangle(&self, i: u32) -> Triangle {
-        TriMesh::triangle(self, i)
-    }
-
-    fn any_triangle(&self, visit: impl Fn(&BoxAabb) -> bool, hit: impl FnMut(u32) -> bool) -> bool {
-        self.bvh().leaves(|node: &BvhNode| visit(&node.aabb())).any(hit)
-    }
-
-    fn find_best<L: BvhLeafCost>(
-        &self,
-        max_cost: Real,
-        aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
-        leaf_cost: impl Fn(u32, Real) -> Option<L>,
-    ) -> Option<(u32, L)> {
-        self.bvh().find_best(
-            max_cost,
-            |node: &BvhNode, best| aabb_cost(&node.aabb(), best),
-            leaf_cost,
-        )
-    }
 }
 
 /// A node: an `f32` box rounded outwards; a leaf holds triangles `first..first + count`, an
@@ -269,6 +250,32 @@ impl CompactMesh {
             + self.nodes.capacity() * size_of::<Node>()
     }
 
+    /// The number of triangles.
+    #[cfg(test)]
+    pub(crate) fn num_triangles(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// A box around every triangle (the root's, rounded outwards).
+    pub(crate) fn local_aabb(&self) -> BoxAabb {
+        self.nodes[0].aabb()
+    }
+
+    /// The projection of `pt` on the nearest triangle, and that triangle.
+    fn project(&self, pt: &Point3, solid: bool) -> (PointProjection, u32) {
+        let project = |i: u32| {
+            let p = self.triangle(i).project_local_point(pt, solid);
+            ((p.point - pt).norm(), p)
+        };
+        self.find_best(
+            Real::MAX,
+            |aabb, _| aabb.distance_to_local_point(pt, true),
+            |i, _| Some(project(i)),
+        )
+        // Only a point with a NaN coordinate finds nothing.
+        .map_or_else(|| (project(0).1, 0), |(i, (_, p))| (p, i))
+    }
+
     /// The `f64` box of triangle `i`.
     fn triangle_aabb(&self, i: u32) -> BoxAabb {
         let [a, b, c] = self.indices[i as usize].map(|v| self.vertices[v as usize]);
@@ -429,10 +436,86 @@ impl IndexedMesh for CompactMesh {
     }
 }
 
+impl PointQuery for CompactMesh {
+    fn project_local_point(&self, pt: &Point3, solid: bool) -> PointProjection {
+        self.project(pt, solid).0
+    }
+
+    fn project_local_point_and_get_feature(&self, pt: &Point3) -> (PointProjection, FeatureId) {
+        let (p, i) = self.project(pt, false);
+        (p, FeatureId::Face(i))
+    }
+}
+
+impl RayCast for CompactMesh {
+    fn cast_local_ray_and_get_normal(
+        &self,
+        ray: &Ray,
+        max_time_of_impact: Real,
+        solid: bool,
+    ) -> Option<RayIntersection> {
+        let (i, (_, mut hit)) = self.find_best(
+            max_time_of_impact.next_up(),
+            |aabb, best| aabb.cast_local_ray(ray, best, true).unwrap_or(Real::MAX),
+            |i, best| {
+                let hit = self.triangle(i).cast_local_ray_and_get_normal(ray, best, solid)?;
+                Some((hit.time_of_impact, hit))
+            },
+        )?;
+        hit.feature = FeatureId::Face(i);
+        Some(hit)
+    }
+}
+
+/// A custom parry shape, so a rapier collider can hold the mesh.
+impl Shape for CompactMesh {
+    fn compute_local_aabb(&self) -> BoxAabb {
+        self.local_aabb()
+    }
+
+    fn compute_local_bounding_sphere(&self) -> BoundingSphere {
+        self.local_aabb().bounding_sphere()
+    }
+
+    fn clone_dyn(&self) -> Box<dyn Shape> {
+        Box::new(self.clone())
+    }
+
+    /// Not supported (the maps never scale their colliders).
+    fn scale_dyn(&self, _scale: &Vector<Real>, _num_subdivisions: u32) -> Option<Box<dyn Shape>> {
+        None
+    }
+
+    fn mass_properties(&self, density: Real) -> MassProperties {
+        MassProperties::from_trimesh(density, &self.vertices, &self.indices)
+    }
+
+    fn shape_type(&self) -> ShapeType {
+        ShapeType::Custom
+    }
+
+    fn as_typed_shape(&self) -> TypedShape<'_> {
+        TypedShape::Custom(self)
+    }
+
+    /// As parry's triangle mesh: no thickness.
+    fn ccd_thickness(&self) -> Real {
+        0.0
+    }
+
+    /// As parry's triangle mesh.
+    fn ccd_angular_thickness(&self) -> Real {
+        std::f64::consts::FRAC_PI_4
+    }
+
+    fn compute_aabb(&self, position: &Isometry<Real>) -> BoxAabb {
+        self.local_aabb().transform_by(position)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use parry3d_f64::query::PointQuery as _;
     use proptest::prelude::*;
 
     fn mesh(points: &[[Real; 9]]) -> CompactMesh {
@@ -533,6 +616,25 @@ mod tests {
             let any = mesh.any_triangle(inside, |_| true);
             let scan = (0..tris.len() as u32).any(|i| inside(&mesh.triangle_aabb(i)));
             prop_assert_eq!(any, scan);
+        }
+
+        /// As a parry shape: point projections and ray casts answer like a scan.
+        #[test]
+        fn shape_queries_answer_like_a_scan(tris in triangles(), q in prop::array::uniform3(-60.0..60.0), d in prop::array::uniform3(-1.0..1.0)) {
+            let mesh = mesh(&tris);
+            let q = Point3::from(q);
+            let all = || (0..tris.len() as u32).map(|i| mesh.triangle(i));
+            let nearest = all()
+                .map(|t| (t.project_local_point(&q, false).point - q).norm())
+                .min_by(Real::total_cmp)
+                .unwrap();
+            let (p, feature) = mesh.project_local_point_and_get_feature(&q);
+            prop_assert_eq!((p.point - q).norm(), nearest);
+            let FeatureId::Face(i) = feature else { panic!("{feature:?}") };
+            prop_assert_eq!((mesh.triangle(i).project_local_point(&q, false).point - q).norm(), nearest);
+            let ray = Ray::new(q, Vector::from(d) * 100.0);
+            let first = all().filter_map(|t| t.cast_local_ray(&ray, 1.0, true)).min_by(Real::total_cmp);
+            prop_assert_eq!(mesh.cast_local_ray(&ray, 1.0, true), first);
         }
     }
 }

@@ -3,21 +3,25 @@
 //! object in the engine's world, the step a sphere cast).
 //!
 //! # Layout
-//! * Every patch becomes one rapier [`Collider`] with a parry [`TriMesh`] shape: a planar
-//!   patch its constrained Delaunay triangulation, a trimesh patch its triangles. The collider
-//!   sits at the identity with world-coordinate vertices, so its triangles are exactly those of
-//!   the [`TrimeshMap`](crate::TrimeshMap): the two maps differ only in their acceleration
-//!   structure (one BVH over all triangles there; here a BVH over the colliders' boxes, then
-//!   each collider's own triangle BVH). The collider's `user_data` is its [`PatchId`].
-//!   (parry 0.25 has no flat convex polygon shape in 3D, and a `ConvexPolyhedron` needs a
-//!   non-degenerate hull, so convex planar patches are triangle meshes too.)
+//! * Every patch becomes one rapier [`Collider`] whose shape is a triangle mesh: a planar
+//!   patch its constrained Delaunay triangulation, a trimesh patch its triangles. The shape is
+//!   the trimesh map's compact mesh (a custom parry shape: `f64` vertices, `u32` indices and a
+//!   BVH of `f32` boxes with up to four triangles per leaf, about 60 bytes per triangle, where
+//!   parry's own `TriMesh` took about 200 with its per-triangle BVH and build buffers). The
+//!   collider sits at the identity with world-coordinate vertices, so its triangles are exactly
+//!   those of the [`TrimeshMap`](crate::TrimeshMap): the two maps differ only in their
+//!   acceleration structure (one BVH over all triangles there; here rapier's BVH over the
+//!   colliders' boxes, then each collider's own triangle BVH). The collider's `user_data` is
+//!   its [`PatchId`]. (parry 0.25 has no flat convex polygon shape in 3D, and a
+//!   `ConvexPolyhedron` needs a non-degenerate hull, so convex planar patches are triangle
+//!   meshes too.)
 //! * The colliders live in a [`ColliderSet`] without rigid bodies; their boxes are inserted
 //!   into a [`BroadPhaseBvh`] with [`BroadPhaseBvh::set_aabb`], and queries see them through
 //!   the [`QueryPipeline`] that [`BroadPhaseBvh::as_query_pipeline`] returns.
 //!
 //! # Queries
-//! Proximity is rapier's [`QueryPipeline::project_point`] as it is (parry's exact point
-//! projection in each candidate collider). The step queries walk the pipeline's collider BVH
+//! Proximity is rapier's [`QueryPipeline::project_point`] as it is (in each candidate collider,
+//! the mesh's best-first walk with parry's exact point projection on the triangles). The step queries walk the pipeline's collider BVH
 //! and run, in each collider whose box the step may reach, the same guarded per-mesh queries as
 //! the trimesh map ([module docs there](crate::trimesh)), because rapier's own `cast_ray`,
 //! `cast_shape` and `intersect_shape` call the parry per-triangle tests the trimesh map had to
@@ -48,10 +52,11 @@ use rapier3d_f64::dynamics::{IntegrationParameters, RigidBodySet};
 use rapier3d_f64::geometry::{BroadPhaseBvh, Collider, ColliderBuilder, ColliderSet};
 use rapier3d_f64::parry::partitioning::BvhNode;
 use rapier3d_f64::parry::query::DefaultQueryDispatcher;
-use rapier3d_f64::parry::shape::{TriMesh, TriMeshFlags};
+use rapier3d_f64::parry::shape::SharedShape;
 use rapier3d_f64::pipeline::{QueryFilter, QueryPipeline};
 
 use crate::Backend;
+use crate::compact_mesh::CompactMesh;
 use crate::mapfile::{MapCounts, MapFileError, read_map, write_map};
 use crate::persist::{MapFile, MemoryUsage, patch_counts, patches_memory_bytes};
 use crate::trimesh::{
@@ -148,12 +153,11 @@ impl RapierMap {
         let id = next_id(self.patches.len())?;
         let (vertices, triangles) = world_triangles(&patch, id.index())?;
         let k = triangles.len();
-        // No flags: the index buffer stays as built (no merging or deleting of triangles).
+        // `world_triangles` makes at least one triangle of every patch.
+        let (mesh, _) = CompactMesh::build(vertices, triangles, vec![(); k])
+            .ok_or(MeshMapError::MeshTooLarge)?;
         let collider =
-            ColliderBuilder::trimesh_with_flags(vertices, triangles, TriMeshFlags::empty())
-                .map_err(|_| MeshMapError::MeshTooLarge)?
-                .user_data(u128::from(id.0))
-                .build();
+            ColliderBuilder::new(SharedShape::new(mesh)).user_data(u128::from(id.0)).build();
         let aabb = collider.compute_aabb();
         let handle = self.world.colliders.insert(collider);
         self.world.broad_phase.set_aabb(&IntegrationParameters::default(), handle, aabb);
@@ -197,8 +201,8 @@ impl RapierMap {
             .map(|(_, c)| {
                 size_of::<Collider>()
                     + c.shape()
-                        .as_trimesh()
-                        .map_or(0, |m| size_of::<TriMesh>() + m.heap_memory_size())
+                        .as_shape::<CompactMesh>()
+                        .map_or(0, |m| size_of::<CompactMesh>() + m.heap_bytes())
             })
             .sum();
         patches_memory_bytes(&self.patches)
@@ -211,10 +215,10 @@ impl RapierMap {
 /// # Queries on the colliders
 impl RapierMap {
     /// The patch and triangle mesh of the collider at BVH leaf `leaf`.
-    fn collider(&self, leaf: u32) -> Option<(PatchId, &TriMesh)> {
+    fn collider(&self, leaf: u32) -> Option<(PatchId, &CompactMesh)> {
         let (collider, _) = self.world.colliders.get_unknown_gen(leaf)?;
         let id = PatchId(u32::try_from(collider.user_data).ok()?);
-        Some((id, collider.shape().as_trimesh()?))
+        Some((id, collider.shape().as_shape::<CompactMesh>()?))
     }
 
     /// Whether the probe touches any collider.
@@ -244,7 +248,7 @@ impl RapierMap {
     }
 
     /// The triangle mesh of a patch's collider.
-    fn collider_of(&self, id: PatchId) -> Option<&TriMesh> {
+    fn collider_of(&self, id: PatchId) -> Option<&CompactMesh> {
         // Colliders are inserted in id order into a set nothing is ever removed from, so the
         // arena index of patch `i` is `i`; checked through the user data anyway.
         self.collider(id.0).filter(|(found, _)| *found == id).map(|(_, mesh)| mesh)
@@ -399,7 +403,7 @@ mod tests {
         assert_eq!(pipeline.colliders.len(), 2);
         for (i, (_, c)) in pipeline.colliders.iter().enumerate() {
             assert_eq!(c.user_data, i as u128);
-            assert_eq!(c.shape().as_trimesh().map(|m| m.num_triangles()), Some(2));
+            assert_eq!(c.shape().as_shape::<CompactMesh>().map(|m| m.num_triangles()), Some(2));
         }
         let step =
             CapsuleStep::new(Point3::new(1.0, 2.0, 1.0), Point3::new(6.0, 2.0, 1.0), 0.5).unwrap();
