@@ -210,24 +210,37 @@ impl CompactMesh {
         nodes.shrink_to_fit();
         drop(items);
         // Triangles in leaf order, and vertices in the order the triangles first use them, so
-        // a walk reads both nearly sequentially (unused vertices are dropped).
+        // a walk reads both nearly sequentially (unused vertices are dropped). The vertices
+        // are permuted in place: a copy would double the largest array for a moment.
         let mut new_index = vec![u32::MAX; vertices.len()];
-        let mut kept = Vec::with_capacity(vertices.len().min(3 * indices.len()));
+        let mut used = 0u32;
         let indices: Vec<[u32; 3]> = order
             .iter()
             .map(|&i| {
                 indices[i as usize].map(|v| {
                     let slot = &mut new_index[v as usize];
                     if *slot == u32::MAX {
-                        *slot = kept.len() as u32;
-                        kept.push(vertices[v as usize]);
+                        *slot = used;
+                        used += 1;
                     }
                     *slot
                 })
             })
             .collect();
+        for (next, slot) in (used..).zip(new_index.iter_mut().filter(|s| **s == u32::MAX)) {
+            *slot = next;
+        }
+        let mut vertices = vertices;
+        for i in 0..vertices.len() {
+            // Move the vertex at `i` to its place until the one that belongs at `i` arrives.
+            while new_index[i] as usize != i {
+                let j = new_index[i] as usize;
+                vertices.swap(i, j);
+                new_index.swap(i, j);
+            }
+        }
         drop(new_index);
-        let mut vertices = kept;
+        vertices.truncate(used as usize);
         vertices.shrink_to_fit();
         let tags = order.iter().map(|&i| tags[i as usize]).collect();
         Some((CompactMesh { vertices, indices, nodes }, tags))

@@ -648,6 +648,24 @@ struct MeshBuilder {
 }
 
 impl MeshBuilder {
+    /// A builder with room for the patches' triangles (a planar patch of `n` vertices and `h`
+    /// holes triangulates into at most `n` vertices and `n + 2h − 2` triangles), so the buffers
+    /// never grow by doubling past what they hold.
+    fn for_patches(patches: &[Patch]) -> MeshBuilder {
+        let (v, t) = patches.iter().fold((0, 0), |(v, t), patch| match patch {
+            Patch::Planar(p) => {
+                let (n, h) = (p.polygon().num_vertices(), p.polygon().holes().len());
+                (v + n, t + (n + 2 * h).saturating_sub(2))
+            }
+            Patch::Trimesh(m) => (v + m.vertices().len(), t + m.triangles().len()),
+        });
+        MeshBuilder {
+            vertices: Vec::with_capacity(v),
+            indices: Vec::with_capacity(t),
+            patch_of: Vec::with_capacity(t),
+        }
+    }
+
     fn push(
         &mut self,
         id: PatchId,
@@ -753,7 +771,7 @@ impl TrimeshMap {
     /// [`MapError::TooManyPatches`] past `u32::MAX` patches.
     pub fn build(patches: impl IntoIterator<Item = Patch>) -> Result<TrimeshMap, MeshMapError> {
         let patches: Vec<Patch> = patches.into_iter().collect();
-        let mut builder = MeshBuilder::default();
+        let mut builder = MeshBuilder::for_patches(&patches);
         let mut bounds = Aabb::EMPTY;
         for (i, patch) in patches.iter().enumerate() {
             let id = next_id(i)?;
