@@ -135,14 +135,28 @@ impl MapFile for BBox6dMap {
     }
 }
 
+/// The points of a map, serialised as a sequence of `[x, y, z]` straight from the map (no copy
+/// of millions of points just to write them).
+struct PointTriples<'a>(&'a PointCloudMap);
+
+impl serde::Serialize for PointTriples<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeSeq as _;
+        let mut seq = serializer.serialize_seq(Some(self.0.len()))?;
+        for p in self.0.points() {
+            seq.serialize_element(&[p.x, p.y, p.z])?;
+        }
+        seq.end()
+    }
+}
+
 impl MapFile for PointCloudMap {
     const BACKEND: Backend = Backend::PointCloud;
 
     /// Writes the points as `[x, y, z]` triples (in the map's level order, not necessarily the
     /// order they were added in; the answers of the map do not depend on it).
     fn save(&self, writer: impl Write) -> Result<u64, MapFileError> {
-        let points: Vec<[Real; 3]> = self.points().map(|p| [p.x, p.y, p.z]).collect();
-        write_map(writer, Self::BACKEND.name(), self.counts(), &points)
+        write_map(writer, Self::BACKEND.name(), self.counts(), &PointTriples(self))
     }
 
     /// Reads the points and rebuilds the trees; a non-finite point is

@@ -313,7 +313,7 @@ pub fn pc_points(clouds: &[PointCloud], cleaning: &PcCleaning) -> Result<Vec<Poi
         let carved = FreeSpace::new(&clouds, config)?.carve_clouds(&clouds)?.0;
         cleaned = carved.into_iter().map(Cow::Owned).collect();
     }
-    let mut out = Vec::new();
+    let mut out = Vec::with_capacity(cleaned.iter().map(|c| c.len()).sum());
     for cloud in &cleaned {
         out.extend_from_slice(cloud.to_world().positions());
     }

@@ -109,21 +109,25 @@ pub fn patch_counts(patches: &[Patch]) -> Result<(usize, usize, usize)> {
 /// Simplifies `triangles` by vertex clustering for the pictures: vertices snapped to the centre
 /// of mass of their cell of a cubic grid, collapsed and repeated triangles dropped, the cell
 /// doubled from 5 cm until at most `budget` remain (then thinned evenly). A coarse but complete
-/// surface, unlike every n-th triangle.
-fn cluster_triangles(triangles: &[[P3; 3]], budget: usize) -> Vec<[P3; 3]> {
+/// surface, unlike every n-th triangle. `triangles` makes the input afresh for each pass, so a
+/// map of millions of triangles is never copied whole.
+fn cluster_triangles<I: Iterator<Item = [P3; 3]>>(
+    triangles: impl Fn() -> I,
+    budget: usize,
+) -> Vec<[P3; 3]> {
     use std::collections::{HashMap, HashSet};
     let mut cell = 0.05;
     loop {
         let key = |q: &P3| q.map(|c| (c / cell).floor() as i64);
         let mut sums: HashMap<[i64; 3], ([f64; 3], f64)> = HashMap::new();
-        for q in triangles.iter().flatten() {
-            let e = sums.entry(key(q)).or_insert(([0.0; 3], 0.0));
+        for q in triangles().flatten() {
+            let e = sums.entry(key(&q)).or_insert(([0.0; 3], 0.0));
             (0..3).for_each(|i| e.0[i] += q[i]);
             e.1 += 1.0;
         }
         let mut seen = HashSet::new();
         let mut out = Vec::new();
-        for t in triangles {
+        for t in triangles() {
             let k = t.map(|q| key(&q));
             if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
                 continue;
@@ -152,22 +156,31 @@ fn p3mm_raw(q: P3) -> P3 {
 /// The drawing of patches: outlines of planar patches, triangles of trimesh patches
 /// (simplified by clustering the triangles).
 pub fn drawing(kind: MapKind, patches: &[Patch]) -> MapDrawing {
-    let mut polygons = Vec::new();
-    let mut triangles = Vec::new();
-    for patch in patches {
-        match patch {
-            Patch::Planar(p) => polygons
-                .push(p.polygon().outer().points().iter().map(|q| p3mm(&p.to_world(q))).collect()),
-            Patch::Trimesh(m) => {
-                let v = m.vertices();
-                triangles.extend(m.triangles().iter().map(|t| t.map(|i| p3mm(&v[i as usize]))));
+    let polygons: Vec<_> = patches
+        .iter()
+        .filter_map(|patch| match patch {
+            Patch::Planar(p) => {
+                Some(p.polygon().outer().points().iter().map(|q| p3mm(&p.to_world(q))).collect())
             }
-        }
-    }
+            Patch::Trimesh(_) => None,
+        })
+        .collect();
+    let triangles = || {
+        patches
+            .iter()
+            .filter_map(|patch| match patch {
+                Patch::Trimesh(m) => Some(m),
+                Patch::Planar(_) => None,
+            })
+            .flat_map(|m| {
+                let v = m.vertices();
+                m.triangles().iter().map(move |t| t.map(|i| p3mm(&v[i as usize])))
+            })
+    };
     MapDrawing {
         kind: kind.name().to_owned(),
         polygons: decimate(&polygons, MAX_DRAWN),
-        triangles: cluster_triangles(&triangles, MAX_DRAWN),
+        triangles: cluster_triangles(triangles, MAX_DRAWN),
         points: Vec::new(),
     }
 }
