@@ -97,12 +97,18 @@ pub(crate) struct CompactMesh {
     nodes: Vec<Node>,
 }
 
-/// A triangle's box (rounded outwards) and centroid during the build.
+/// A triangle's box (rounded outwards) during the build.
 #[derive(Clone, Copy)]
 struct Item {
     min: [f32; 3],
     max: [f32; 3],
-    centroid: [f32; 3],
+}
+
+impl Item {
+    /// The centre of the box along `axis` (the triangle's "centroid" for binning).
+    fn centroid(&self, axis: usize) -> Real {
+        0.5 * (Real::from(self.min[axis]) + Real::from(self.max[axis]))
+    }
 }
 
 /// A box under construction.
@@ -176,8 +182,7 @@ impl CompactMesh {
                     let p = &vertices[i as usize];
                     b.add_point(&[p.x, p.y, p.z]);
                 }
-                let centroid = [0, 1, 2].map(|k| (0.5 * (b.min[k] + b.max[k])) as f32);
-                Item { min: b.min.map(down), max: b.max.map(up), centroid }
+                Item { min: b.min.map(down), max: b.max.map(up) }
             })
             .collect();
         let mut order: Vec<u32> = (0..indices.len() as u32).collect();
@@ -214,19 +219,22 @@ impl CompactMesh {
         // are permuted in place: a copy would double the largest array for a moment.
         let mut new_index = vec![u32::MAX; vertices.len()];
         let mut used = 0u32;
-        let indices: Vec<[u32; 3]> = order
-            .iter()
-            .map(|&i| {
-                indices[i as usize].map(|v| {
-                    let slot = &mut new_index[v as usize];
-                    if *slot == u32::MAX {
-                        *slot = used;
-                        used += 1;
-                    }
-                    *slot
-                })
-            })
-            .collect();
+        for &i in &order {
+            for v in indices[i as usize] {
+                let slot = &mut new_index[v as usize];
+                if *slot == u32::MAX {
+                    *slot = used;
+                    used += 1;
+                }
+            }
+        }
+        let tags = order.iter().map(|&i| tags[i as usize]).collect();
+        // The triangles into leaf order in place (consuming `order`), then renumbered.
+        let mut indices = indices;
+        permute_in_place(&mut indices, &mut order);
+        for t in &mut indices {
+            *t = t.map(|v| new_index[v as usize]);
+        }
         for (next, slot) in (used..).zip(new_index.iter_mut().filter(|s| **s == u32::MAX)) {
             *slot = next;
         }
@@ -242,7 +250,6 @@ impl CompactMesh {
         drop(new_index);
         vertices.truncate(used as usize);
         vertices.shrink_to_fit();
-        let tags = order.iter().map(|&i| tags[i as usize]).collect();
         Some((CompactMesh { vertices, indices, nodes }, tags))
     }
 
@@ -296,6 +303,28 @@ impl CompactMesh {
     }
 }
 
+/// Reorders `data` so that `data[k]` becomes the old `data[order[k]]`, without a second copy;
+/// `order` (a permutation) is used up.
+fn permute_in_place<T: Copy>(data: &mut [T], order: &mut [u32]) {
+    for start in 0..data.len() {
+        if order[start] == u32::MAX {
+            continue;
+        }
+        let first = data[start];
+        let mut k = start;
+        loop {
+            let from = order[k] as usize;
+            order[k] = u32::MAX;
+            if from == start {
+                data[k] = first;
+                break;
+            }
+            data[k] = data[from];
+            k = from;
+        }
+    }
+}
+
 /// Splits `order` (at least two triangles) in place and returns the size of the first part
 /// (never 0 or all): the best of [`BINS`] centroid bins along the longest centroid axis by the
 /// surface area heuristic, or the median below depth [`SAH_DEPTH`] and where the heuristic
@@ -303,14 +332,15 @@ impl CompactMesh {
 fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     let mut cb = Bounds::EMPTY;
     for &i in order.iter() {
-        cb.add_point(&items[i as usize].centroid.map(Real::from));
+        let item = &items[i as usize];
+        cb.add_point(&[0, 1, 2].map(|k| item.centroid(k)));
     }
     let extent = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
     let axis = (0..3).fold(0, |a, k| if extent[k] > extent[a] { k } else { a });
     let median = |order: &mut [u32]| {
         let mid = order.len() / 2;
         order.select_nth_unstable_by(mid, |&x, &y| {
-            items[x as usize].centroid[axis].total_cmp(&items[y as usize].centroid[axis])
+            items[x as usize].centroid(axis).total_cmp(&items[y as usize].centroid(axis))
         });
         mid
     };
@@ -320,7 +350,7 @@ fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     }
     let scale = BINS as Real / extent[axis];
     let bin = |i: u32| {
-        let b = ((Real::from(items[i as usize].centroid[axis]) - cb.min[axis]) * scale) as usize;
+        let b = ((items[i as usize].centroid(axis) - cb.min[axis]) * scale) as usize;
         b.min(BINS - 1)
     };
     let mut boxes = [Bounds::EMPTY; BINS];
