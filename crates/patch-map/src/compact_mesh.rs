@@ -337,21 +337,15 @@ fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     }
     let extent = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
     let axis = (0..3).fold(0, |a, k| if extent[k] > extent[a] { k } else { a });
-    // Small sets split so the left part fills whole leaves: `n` triangles end in
-    // `⌈n / LEAF_SIZE⌉` leaves, the fewest nodes.
-    let leaves = order.len().div_ceil(LEAF_SIZE);
     let median = |order: &mut [u32]| {
-        let mid = if leaves <= 4 { LEAF_SIZE * leaves.div_ceil(2) } else { order.len() / 2 };
+        let mid = order.len() / 2;
         order.select_nth_unstable_by(mid, |&x, &y| {
             items[x as usize].centroid(axis).total_cmp(&items[y as usize].centroid(axis))
         });
         mid
     };
     // `extent` is 0 (or NaN, never for finite vertices) when all centroids coincide.
-    if depth >= SAH_DEPTH
-        || leaves <= 4
-        || extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-    {
+    if depth >= SAH_DEPTH || extent[axis].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return median(order);
     }
     let scale = BINS as Real / extent[axis];
