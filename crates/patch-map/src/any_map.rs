@@ -170,6 +170,20 @@ impl AnyMap {
         }
     }
 
+    /// Gives the patches of a patch map back, in id order, dropping the rest of the map (so
+    /// one set of patches can be loaded into every backend in turn without a copy); `None` for
+    /// a point-cloud map.
+    pub fn into_patches(self) -> Option<Vec<Patch>> {
+        match self {
+            AnyMap::Polygon(m) => Some(m.into_patches()),
+            AnyMap::BBox6d(m) => Some(m.into_patches()),
+            AnyMap::PointCloud(_) => None,
+            AnyMap::Trimesh(m) => Some(m.into_patches()),
+            #[cfg(feature = "rapier")]
+            AnyMap::Rapier(m) => Some(m.into_patches()),
+        }
+    }
+
     /// The patches of a patch map, in id order; `None` for a point-cloud map.
     pub fn patches(&self) -> Option<&[Patch]> {
         match self {

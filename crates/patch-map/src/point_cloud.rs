@@ -121,28 +121,29 @@ impl PointCloudMap {
         if self.len + points.len() > Self::MAX_POINTS {
             return Err(PointCloudMapError::TooMany { max: Self::MAX_POINTS });
         }
-        let mut pending: Vec<[Real; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
         for p in points {
             self.bounds.grow(p);
         }
         // Binary-counter merge, one level per set bit of the new length: the new points and
-        // every level whose bit carries are rebuilt into the level where the carry stops.
-        let new_len = self.len + pending.len();
+        // every level whose bit carries are rebuilt into the level where the carry stops. The
+        // points flow from the input and the old levels straight into the new levels (each
+        // level takes the last points of "new points, then the old levels' points"), so the
+        // merge holds one copy of them, not three.
+        let new_len = self.len + points.len();
         let bits = (usize::BITS - new_len.leading_zeros()) as usize;
         self.levels.resize_with(bits.max(self.levels.len()), || None);
-        for level in 0..self.levels.len() {
-            if let Some(l) = self.levels[level].take() {
-                pending.extend(l.points);
-            }
-        }
+        let old: Vec<Vec<[Real; 3]>> =
+            self.levels.iter_mut().filter_map(|l| l.take().map(|l| l.points)).collect();
+        let mut pending = points.iter().map(|p| [p.x, p.y, p.z]).chain(old.into_iter().flatten());
         for level in (0..self.levels.len()).rev() {
             let size = 1usize << level;
             if new_len & size != 0 {
-                let tail = pending.split_off(pending.len() - size);
+                let mut tail: Vec<[Real; 3]> = pending.by_ref().rev().take(size).collect();
+                tail.reverse();
                 self.levels[level] = Some(Level::build(tail));
             }
         }
-        debug_assert!(pending.is_empty());
+        debug_assert!(pending.next().is_none());
         self.len = new_len;
         Ok(())
     }

@@ -170,6 +170,11 @@ impl RapierMap {
 
 /// # Inspection
 impl RapierMap {
+    /// Gives the patches back, in id order (the colliders are dropped).
+    pub fn into_patches(self) -> Vec<Patch> {
+        self.patches
+    }
+
     /// The number of triangles (of all colliders).
     pub fn num_triangles(&self) -> usize {
         self.triangles

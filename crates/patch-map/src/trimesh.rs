@@ -1,30 +1,35 @@
-//! The parry trimesh map: every patch as triangles in one parry [`TriMesh`] with its bounding
+//! The trimesh map: every patch as triangles in one compact triangle mesh with its bounding
 //! volume hierarchy (the role of the thesis's OPCODE and Bullet maps, §5.4.2: "planar patches
-//! are Delaunay-triangulated into trimeshes", the step is a sphere cast, L5572–5582).
+//! are Delaunay-triangulated into trimeshes", the step is a sphere cast, L5572–5582), queried
+//! with parry's per-triangle geometry.
 //!
 //! # Layout
 //! * Planar patches are triangulated in their own 2D frame ([`triangulate_polygon`], a
 //!   constrained Delaunay triangulation with holes, checked to tile the polygon) and the
 //!   triangles mapped to the world by `world_from_patch`; trimesh patches are taken as they
 //!   are.
-//! * All triangles go into one parry [`TriMesh`] (no vertex merging, no topology: the index
-//!   buffer stays exactly as built), and a table `patch_of[triangle]` maps every triangle back
-//!   to its [`PatchId`].
+//! * All triangles go into one compact mesh (no vertex merging, no topology): `f64` vertices,
+//!   a `[u32; 3]` per triangle, and a BVH of 32-byte nodes with `f32` boxes rounded outwards
+//!   and up to four triangles per leaf, built by the surface area heuristic; triangles and
+//!   vertices are stored in the tree's order. A table `patch_of[triangle]` maps every triangle
+//!   back to its [`PatchId`]. About 50–60 bytes per triangle plus the patches themselves
+//!   (80 bytes per triangle in all on the lab's exact trimesh map; parry's `TriMesh`, with one
+//!   `f64` BVH leaf per triangle, took 206).
 //!
 //! # Queries
-//! Every query walks the mesh's BVH (parry's `find_best` for first hits and nearest points,
-//! its leaf iterator for any-hit tests) and runs parry's per-triangle geometry on the leaves:
+//! Every query walks the mesh's BVH (best-first for first hits and nearest points, depth-first
+//! for any-hit tests; at a leaf each triangle's own `f64` box is tested first) and runs
+//! parry's per-triangle geometry on the triangles:
 //!
 //! | query | per triangle | degenerate branches |
 //! |---|---|---|
-//! | proximity | parry's point projection (`project_local_point_and_get_location` on the mesh) | — |
+//! | proximity | parry's point projection on each triangle the walk reaches | — |
 //! | line step | parry's ray–triangle test along `end − start` | segments (nearly) parallel to the triangle, zero-length ones included: `patch-core`'s kernel in the triangle's frame ([`TriangleFrame::first_contact`] with radius 0) |
 //! | capsule step, free? | the closed-form segment–triangle distance from parry's primitives (ray–triangle crossing, point projections of both ends, segment–segment closest points to the three edges), compared with `r`; boxes are pruned by casting the segment through them grown by `r` | zero length (below [`SHORT_STEP`]): point projection within `r`; radius 0: the line step |
 //! | capsule step, first hit | on triangles within `r` of the segment (as above): parry's shape cast of a [`Ball`] moving `start → end` (`stop_at_penetration`, so a start that already touches gives `t = 0`) | the cast can miss grazing contacts (see below); for a triangle the distance test says is touched but the cast misses, `patch-core`'s exact sweep kernel gives the time ([`TriangleFrame::first_contact`]); zero length: a sphere test at the start; radius 0: the line step |
 //!
-//! The walk reports the triangle it hit, which names the patch (parry's own composite shape
-//! cast would too, as a part index; its [`ShapeCastHit`](parry3d_f64::query::ShapeCastHit)
-//! has no triangle). The [`StepHit`] is then completed from the patch, not from parry's
+//! The walk reports the triangle it hit, which names the patch (parry's
+//! [`ShapeCastHit`](parry3d_f64::query::ShapeCastHit) has no triangle). The [`StepHit`] is then completed from the patch, not from parry's
 //! witness points (which are undefined at `t = 0`): the contact point is the patch's point
 //! closest to the sphere's centre at `t` (a projection restricted to that patch's triangles),
 //! the normal is the plane normal of a planar patch or the normal of that closest triangle of
@@ -59,14 +64,14 @@
 //! never reported free beyond the numeric band.
 //!
 //! # Adding patches
-//! parry's [`TriMesh`] is immutable (appending rebuilds it). [`FromPatches::from_patches`] and
+//! A mesh is immutable (appending rebuilds it). [`FromPatches::from_patches`] and
 //! loading build one mesh; [`PatchMapMut::add_patch`] uses the logarithmic method (Bentley and
 //! Saxe): the new patch's triangles become a small mesh of their own, and while the newest
 //! mesh holds at least half as many triangles as the one before it, the two are merged and
 //! rebuilt. Mesh sizes thus at least double from newest to oldest: a map of `n` triangles has
 //! at most `log₂ n + 1` meshes, every query walks each of them, and every triangle is rebuilt
 //! `O(log n)` times, so an add of `k` triangles costs amortised `O(k log² n)` (a rebuild of `m`
-//! triangles is parry's `O(m log m)` binned BVH build) plus the triangulation of the patch
+//! triangles is the `O(m log m)` binned BVH build) plus the triangulation of the patch
 //! (`O(v log v)` for `v` vertices). [`TrimeshMap::compact`] merges everything back into one
 //! mesh.
 
@@ -687,8 +692,8 @@ impl MeshBuilder {
     }
 }
 
-/// The parry trimesh map (thesis §5.4.2, the OPCODE/Bullet role): all patches as triangles in
-/// one parry [`TriMesh`] with its BVH; see the [module docs](self) for the queries, their
+/// The trimesh map (thesis §5.4.2, the OPCODE/Bullet role): all patches as triangles in one
+/// compact mesh with its BVH; see the [module docs](self) for the queries, their
 /// degenerate branches, the measured accuracy and the cost of adding patches.
 ///
 /// Implements every capability: [`PatchMap`], [`PatchMapMut`], [`FromPatches`],
@@ -834,6 +839,11 @@ impl TrimeshMap {
 
 /// # Inspection
 impl TrimeshMap {
+    /// Gives the patches back, in id order (the meshes are dropped).
+    pub fn into_patches(self) -> Vec<Patch> {
+        self.patches
+    }
+
     /// The number of triangles (of all patches).
     pub fn num_triangles(&self) -> usize {
         self.levels.iter().map(Level::len).sum()

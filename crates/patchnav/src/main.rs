@@ -95,12 +95,6 @@ enum Command {
     Terrain(terrain::TerrainArgs),
 }
 
-/// mimalloc returns freed pages to the system soon after they are freed; the system allocator
-/// keeps the holes a large map's build leaves in its heap, so the demo's resident peak was
-/// about 250 MB above its heap peak.
-#[global_allocator]
-static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let progress = progress::Progress::new(cli.quiet);

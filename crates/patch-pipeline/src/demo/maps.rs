@@ -239,14 +239,13 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
             ),
             &name,
         )?;
-        // The planning backend's map is built last, from the patches themselves, so no other
-        // backend's map (nor a copy of the patches) is alive beside it: the peak is one map.
+        // One set of patches goes through every backend in turn (each map gives it back), the
+        // planning backend's last, so no two maps and no copy of the patches are alive at once.
         let keep = plan_backend(kind);
         let mut patches = Some(patches);
         let mut rows = Vec::new();
         for backend in Backend::patch_backends().filter(|&b| b != keep).chain([keep]) {
-            let input = if backend == keep { patches.take() } else { patches.clone() };
-            let input = input.context("the kept backend comes last")?;
+            let input = patches.take().context("every map gives its patches back")?;
             let t1 = Instant::now();
             let map = patch_map(input, backend)
                 .with_context(|| format!("loading the {kind} map into {}", backend.name()))?;
@@ -255,6 +254,7 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
                 backend,
                 patch_map_row(kind, &map, (planar, trimesh, triangles), extraction + load)?,
             ));
+            bar.inc(1);
             if backend == keep {
                 built.maps.push(BuiltMap {
                     kind,
@@ -265,8 +265,9 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
                     point_clouds: 0,
                     points: 0,
                 });
+            } else {
+                patches = map.into_patches();
             }
-            bar.inc(1);
         }
         // The rows in the backends' order.
         rows.sort_by_key(|(backend, _)| Backend::ALL.iter().position(|b| b == backend));
