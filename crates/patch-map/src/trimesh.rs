@@ -12,8 +12,8 @@
 //!   a `[u32; 3]` per triangle, and a BVH of 32-byte nodes with `f32` boxes rounded outwards
 //!   and up to four triangles per leaf, built by the surface area heuristic; triangles and
 //!   vertices are stored in the tree's order. A table `patch_of[triangle]` maps every triangle
-//!   back to its [`PatchId`]. About 50–60 bytes per triangle plus the patches themselves
-//!   (80 bytes per triangle in all on the lab's exact trimesh map; parry's `TriMesh`, with one
+//!   back to its [`PatchId`]. About 60 bytes per triangle plus the patches themselves
+//!   (91 bytes per triangle in all on the lab's exact trimesh map; parry's `TriMesh`, with one
 //!   `f64` BVH leaf per triangle, took 206).
 //!
 //! # Queries
@@ -328,9 +328,16 @@ fn cast_options(max_t: Real) -> ShapeCastOptions {
 }
 
 /// The first time in `[0, max_t]` at which `ray.origin + t ray.dir` is inside the box grown by
-/// `grow` (0 if the origin is inside): the slab test. Equal to parry's `cast_local_ray` on the
+/// `grow` (0 if the origin is inside): the slab test, with `inv` the componentwise inverse of
+/// `ray.dir` (computed once per probe: the walks test many boxes). Equal to parry's `cast_local_ray` on the
 /// grown box with `solid`, without building the grown box.
-fn segment_enters_box(ray: &Ray, aabb: &BoxAabb, grow: Real, max_t: Real) -> Option<Real> {
+fn segment_enters_box(
+    ray: &Ray,
+    inv: &Vector3,
+    aabb: &BoxAabb,
+    grow: Real,
+    max_t: Real,
+) -> Option<Real> {
     let (mut t0, mut t1): (Real, Real) = (0.0, max_t);
     for k in 0..3 {
         let (lo, hi) = (aabb.mins[k] - grow, aabb.maxs[k] + grow);
@@ -340,8 +347,7 @@ fn segment_enters_box(ray: &Ray, aabb: &BoxAabb, grow: Real, max_t: Real) -> Opt
                 return None;
             }
         } else {
-            let inv = 1.0 / d;
-            let (a, b) = ((lo - o) * inv, (hi - o) * inv);
+            let (a, b) = ((lo - o) * inv[k], (hi - o) * inv[k]);
             let (a, b) = if a <= b { (a, b) } else { (b, a) };
             t0 = t0.max(a);
             t1 = t1.min(b);
@@ -370,6 +376,8 @@ pub(crate) enum Probe {
         b: Point3,
         /// `a` along `b − a`.
         ray: Ray,
+        /// `1 / (b − a)` componentwise, for the slab tests.
+        inv: Vector3,
     },
     /// A sphere at `center` (a zero-length or very short step).
     Sphere {
@@ -388,6 +396,8 @@ pub(crate) enum Probe {
         r: Real,
         /// `a` along `b − a`.
         ray: Ray,
+        /// `1 / (b − a)` componentwise, for the slab tests.
+        inv: Vector3,
         /// The ball for parry's shape cast.
         ball: Ball,
     },
@@ -398,11 +408,12 @@ impl Probe {
     pub(crate) fn of<S: Step>(step: &S) -> Probe {
         let (a, b, r) = (step.start(), step.end(), step.radius());
         if r == 0.0 {
-            Probe::Segment { b, ray: Ray::new(a, b - a) }
+            Probe::Segment { b, ray: Ray::new(a, b - a), inv: (b - a).map(|d| 1.0 / d) }
         } else if (b - a).norm() <= SHORT_STEP {
             Probe::Sphere { center: a, r }
         } else {
-            Probe::Sweep { a, b, r, ray: Ray::new(a, b - a), ball: Ball::new(r) }
+            let inv = (b - a).map(|d| 1.0 / d);
+            Probe::Sweep { a, b, r, ray: Ray::new(a, b - a), inv, ball: Ball::new(r) }
         }
     }
 
@@ -410,12 +421,14 @@ impl Probe {
     /// by [`PRUNE_SLACK`] (a float slab test can miss a contact exactly on a box face by an ulp).
     pub(crate) fn may_touch(&self, aabb: &BoxAabb) -> bool {
         match self {
-            Probe::Segment { ray, .. } => segment_enters_box(ray, aabb, PRUNE_SLACK, 1.0).is_some(),
+            Probe::Segment { ray, inv, .. } => {
+                segment_enters_box(ray, inv, aabb, PRUNE_SLACK, 1.0).is_some()
+            }
             Probe::Sphere { center, r } => {
                 aabb.distance_to_local_point(center, true) <= r + PRUNE_SLACK
             }
-            Probe::Sweep { r, ray, .. } => {
-                segment_enters_box(ray, aabb, r + PRUNE_SLACK, 1.0).is_some()
+            Probe::Sweep { r, ray, inv, .. } => {
+                segment_enters_box(ray, inv, aabb, r + PRUNE_SLACK, 1.0).is_some()
             }
         }
     }
@@ -425,9 +438,13 @@ impl Probe {
     /// best-first searches).
     pub(crate) fn box_entry(&self, aabb: &BoxAabb, bound: Real) -> Real {
         let entry = match self {
-            Probe::Segment { ray, .. } => segment_enters_box(ray, aabb, PRUNE_SLACK, bound),
+            Probe::Segment { ray, inv, .. } => {
+                segment_enters_box(ray, inv, aabb, PRUNE_SLACK, bound)
+            }
             Probe::Sphere { .. } => self.may_touch(aabb).then_some(0.0),
-            Probe::Sweep { r, ray, .. } => segment_enters_box(ray, aabb, r + PRUNE_SLACK, bound),
+            Probe::Sweep { r, ray, inv, .. } => {
+                segment_enters_box(ray, inv, aabb, r + PRUNE_SLACK, bound)
+            }
         };
         entry.unwrap_or(Real::MAX)
     }
@@ -462,7 +479,7 @@ impl Probe {
                 }
                 0.0
             }
-            Probe::Sweep { a, b, r, ray, ball } => {
+            Probe::Sweep { a, b, r, ray, ball, .. } => {
                 if !self.touches(tri) {
                     return None;
                 }
