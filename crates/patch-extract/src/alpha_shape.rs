@@ -265,21 +265,44 @@ fn snap(v: Real) -> Real {
     if v.abs() < 1e-30 { 0.0 } else { v }
 }
 
-fn build_mesh(points: &[Point2]) -> Result<Mesh, AlphaShapeError> {
-    if points.len() < 3 {
-        return Err(AlphaShapeError::TooFewPoints { count: points.len() });
+/// A Delaunay vertex: its position and whether it is a fill point ([`alpha_shape_filled`]).
+#[derive(Copy, Clone, Debug)]
+struct Site {
+    position: spade::Point2<Real>,
+    fill: bool,
+}
+
+impl spade::HasPosition for Site {
+    type Scalar = Real;
+
+    fn position(&self) -> spade::Point2<Real> {
+        self.position
     }
-    if let Some(index) = points.iter().position(|p| !(p.x.is_finite() && p.y.is_finite())) {
+}
+
+/// The mesh of `points` followed by `fill` (see [`alpha_shape_filled`]): every triangle with a
+/// fill vertex gets the squared radius [`Real::MIN_POSITIVE`], below every other triangle's,
+/// so it is interior at every α and never decides α.
+fn build_mesh(points: &[Point2], fill: &[Point2]) -> Result<Mesh, AlphaShapeError> {
+    let all = || points.iter().chain(fill);
+    if points.len() + fill.len() < 3 {
+        return Err(AlphaShapeError::TooFewPoints { count: points.len() + fill.len() });
+    }
+    if let Some(index) = all().position(|p| !(p.x.is_finite() && p.y.is_finite())) {
         return Err(AlphaShapeError::BadCoordinate { index });
     }
-    let input: Vec<spade::Point2<Real>> =
-        points.iter().map(|p| spade::Point2::new(snap(p.x), snap(p.y))).collect();
-    let dt = match DelaunayTriangulation::<spade::Point2<Real>>::bulk_load(input) {
+    let input: Vec<Site> = all()
+        .enumerate()
+        .map(|(i, p)| Site {
+            position: spade::Point2::new(snap(p.x), snap(p.y)),
+            fill: i >= points.len(),
+        })
+        .collect();
+    let dt = match DelaunayTriangulation::<Site>::bulk_load(input) {
         Ok(dt) => dt,
         Err(_) => {
             // Find the offending point for the error message.
-            let index = points
-                .iter()
+            let index = all()
                 .position(|p| {
                     spade::validate_coordinate(snap(p.x)).is_err()
                         || spade::validate_coordinate(snap(p.y)).is_err()
@@ -297,6 +320,7 @@ fn build_mesh(points: &[Point2]) -> Result<Mesh, AlphaShapeError> {
     }
     let vertices: Vec<Point2> =
         dt.vertices().map(|v| Point2::new(v.position().x, v.position().y)).collect();
+    let is_fill: Vec<bool> = dt.vertices().map(|v| v.data().fill).collect();
     // Nearly collinear input (e.g. points of a line after projection rounding) gives only
     // slivers: treat a total area below 1e-10 of the squared bounding-box diagonal as
     // collinear.
@@ -351,7 +375,13 @@ fn build_mesh(points: &[Point2]) -> Result<Mesh, AlphaShapeError> {
             let x = (len_b * c.y - len_c * b.y) * d_inv;
             let y = (-len_b * c.x + len_c * b.x) * d_inv;
             let r2 = x * x + y * y;
-            if r2.is_nan() { Real::INFINITY } else { r2 }
+            if triangles[t].iter().any(|&v| is_fill[v as usize]) {
+                Real::MIN_POSITIVE
+            } else if r2.is_nan() {
+                Real::INFINITY
+            } else {
+                r2
+            }
         })
         .collect();
     Ok(Mesh { vertices, triangles, neighbours, radius2 })
@@ -494,7 +524,7 @@ pub fn optimal_alpha(points: &[Point2], max_components: usize) -> Result<Real, A
     if max_components == 0 {
         return Err(AlphaShapeError::InvalidAlpha { value: 0.0 });
     }
-    let mesh = build_mesh(points)?;
+    let mesh = build_mesh(points, &[])?;
     Ok(optimal_alpha_squared(&mesh, max_components, 0).0.sqrt())
 }
 
@@ -510,6 +540,30 @@ pub fn optimal_alpha(points: &[Point2], max_components: usize) -> Result<Real, A
 /// O(n log n) for n points (Delaunay triangulation, sorting, ring validation).
 pub fn alpha_shape(
     points: &[Point2],
+    config: &AlphaShapeConfig,
+) -> Result<AlphaShape, AlphaShapeError> {
+    alpha_shape_filled(points, &[], config)
+}
+
+/// [`alpha_shape`] of `points` together with `fill` points known to lie deep inside the
+/// shape (not in the thesis): every Delaunay triangle with a fill vertex is interior whatever
+/// its circumradius, and counts as the smallest, so fill points never decide α (they are
+/// covered from the start; [`AlphaChoice::Robust`]'s share counts them too). With `fill`
+/// empty this is [`alpha_shape`].
+///
+/// It is meant for the points of an organised region thinned to a band along its pixel
+/// outline plus a sparse lattice inside ([`crate::polygonize::GridThinning`]): the band
+/// decides the outline as all points would, the fill lattice joins the band's parts, so the
+/// empty inside is neither a hole nor a second component.
+///
+/// # Errors
+/// As [`alpha_shape`]; [`AlphaShapeError::BadCoordinate`] indexes `points` then `fill`.
+///
+/// # Complexity
+/// O(n log n) for n points and fill points together.
+pub fn alpha_shape_filled(
+    points: &[Point2],
+    fill: &[Point2],
     config: &AlphaShapeConfig,
 ) -> Result<AlphaShape, AlphaShapeError> {
     match config.alpha {
@@ -535,7 +589,7 @@ pub fn alpha_shape(
     {
         return Err(AlphaShapeError::InvalidAlpha { value: m });
     }
-    let mesh = build_mesh(points)?;
+    let mesh = build_mesh(points, fill)?;
     // With the search's union–find: the components of the triangles it added.
     let (alpha_squared, searched) = match config.alpha {
         AlphaChoice::Radius(a) => (a * a, None),

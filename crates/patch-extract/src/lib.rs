@@ -70,7 +70,7 @@ pub use mixed_pixels::{
 pub use pipeline::{ExtractError, Extraction, PipelineConfig, extract, extract_with_threads};
 pub use polygonize::{PolygonizeConfig, region_to_patch};
 pub use region::{PlanarRegion, Segmentation};
-pub use segment::{GrazingPlanes, SegmentConfig, segment, segment_remainder};
+pub use segment::{GrazingPlanes, SegmentConfig, segment, segment_remainder, segment_with_threads};
 pub use spherical_grid::{SphericalGrid, SphericalGridConfig};
 pub use trimesh_grow::{TrimeshGrowConfig, grow_trimeshes};
 pub use visibility::{FreeSpace, VisibilityConfig};

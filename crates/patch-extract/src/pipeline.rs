@@ -25,8 +25,8 @@ use crate::fill::{FillError, fill_upward_holes};
 use crate::grid_mesh::RegionMask;
 use crate::merge::{MergeConfig, MergeError, MergeStats, merge_coplanar};
 use crate::mixed_pixels::{MixedPixelConfig, MixedPixelError, remove_mixed_pixels};
-use crate::polygonize::{PolygonizeConfig, polygonize_region};
-use crate::segment::{SegmentConfig, SegmentError, segment, segment_remainder};
+use crate::polygonize::{PolygonizeConfig, pixels_of_points, polygonize_region_with};
+use crate::segment::{SegmentConfig, SegmentError, segment_remainder, segment_with_threads};
 use crate::slab::{SlabError, back_faces};
 use crate::spherical_grid::{SphericalGridConfig, SphericalGridError, mesh_unorganised};
 use crate::trimesh_grow::{GrownTrimeshes, TrimeshGrowConfig, TrimeshGrowError, grow_trimeshes_in};
@@ -135,12 +135,13 @@ impl PipelineConfig {
     }
 
     /// For range-camera frames (SR-3000-like): [`SegmentConfig::range_camera`],
-    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    /// [`PolygonizeConfig::thinned`] (the thesis's outlines from the points along each
+    /// region's pixel outline), merging with [`MergeConfig::alrf`], no remainder meshes.
     pub fn range_camera() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::range_camera(),
             second_pass: None,
-            polygonize: PolygonizeConfig::thesis(),
+            polygonize: PolygonizeConfig::thinned(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
@@ -153,12 +154,12 @@ impl PipelineConfig {
     }
 
     /// For structured-light depth frames (Kinect-like): [`SegmentConfig::structured_light`],
-    /// [`PolygonizeConfig::thesis`], merging with [`MergeConfig::alrf`], no remainder meshes.
+    /// [`PolygonizeConfig::thinned`], merging with [`MergeConfig::alrf`], no remainder meshes.
     pub fn structured_light() -> PipelineConfig {
         PipelineConfig {
             segment: SegmentConfig::structured_light(),
             second_pass: None,
-            polygonize: PolygonizeConfig::thesis(),
+            polygonize: PolygonizeConfig::thinned(),
             remainder: None,
             merge: Some(MergeConfig::alrf()),
             mixed_pixels: None,
@@ -406,7 +407,10 @@ pub fn extract_with_threads(
         _ => None,
     };
     let free_space = free_space.as_ref();
-    let threads = threads.get().min(scans.len());
+    let requested = threads.get();
+    let threads = requested.min(scans.len());
+    // Threads left over per scan (fewer scans than threads) go to its segmentation's seeds.
+    let inner = NonZeroUsize::new(requested / threads.max(1)).unwrap_or(NonZeroUsize::MIN);
     let mut parts: Vec<Option<Result<ScanPart, ExtractError>>> = Vec::new();
     parts.resize_with(scans.len(), || None);
     let mut reported = 0;
@@ -418,7 +422,7 @@ pub fn extract_with_threads(
     };
     if threads <= 1 {
         for (index, scan) in scans.iter().enumerate() {
-            parts[index] = Some(extract_scan(index, scan, config, free_space));
+            parts[index] = Some(extract_scan(index, scan, config, free_space, inner));
             report_done(&parts);
         }
     } else {
@@ -431,7 +435,7 @@ pub fn extract_with_threads(
                     loop {
                         let index = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                         let Some(scan) = scans.get(index) else { break };
-                        let part = extract_scan(index, scan, config, free_space);
+                        let part = extract_scan(index, scan, config, free_space, inner);
                         if sender.send((index, part)).is_err() {
                             break;
                         }
@@ -487,6 +491,7 @@ fn extract_scan(
     scan: &PointCloud,
     config: &PipelineConfig,
     free_space: Option<&FreeSpace>,
+    threads: NonZeroUsize,
 ) -> Result<ScanPart, ExtractError> {
     let mut times = StageTimes::default();
     let mut planar: Vec<PlanarPatch> = Vec::new();
@@ -511,7 +516,7 @@ fn extract_scan(
         _ => scan,
     };
     let t = Instant::now();
-    let mut segmentation = segment(scan, &config.segment)
+    let mut segmentation = segment_with_threads(scan, &config.segment, threads)
         .map_err(|source| ExtractError::Segment { scan: index, source })?;
     if let Some(second) = &config.second_pass {
         report.second_pass_regions = segment_remainder(scan, &mut segmentation, second)
@@ -523,8 +528,12 @@ fn extract_scan(
     report.remainder_points = segmentation.remainder.len();
 
     let t = Instant::now();
+    let pixel_of = match (config.polygonize.thinning, scan.grid()) {
+        (Some(_), Some(grid)) => Some(pixels_of_points(grid, scan.len())),
+        _ => None,
+    };
     for region in &segmentation.regions {
-        match polygonize_region(scan, region, &config.polygonize) {
+        match polygonize_region_with(scan, region, &config.polygonize, pixel_of.as_deref()) {
             Ok(p) => {
                 report.planar_patches += p.patches.len();
                 report.outline_vertices.0 += p.vertices_before;

@@ -104,6 +104,10 @@
 //! `patchnav extract`'s stage times); see also the ignored test `measure_lab_scans` in
 //! `tests/it/segment.rs`.
 //!
+//! The seeds' bounds are independent per point: [`segment_with_threads`] (and the pipeline,
+//! with the cores its scans leave free) computes them for large organised clouds on several
+//! threads and sorts them as one list, so the segmentation does not depend on the count.
+//!
 //! # Actuated LRF scans
 //! The ±90° beam column of an actuated LRF sees one line in every row (thesis App. A); run
 //! [`crate::projection::invalidate_alrf_side_columns`] on the organised cloud **before**
@@ -510,11 +514,25 @@ impl SegmentConfig {
 /// # Complexity
 /// O(N α) growth plus O(N log N) seed ordering (module docs, "Complexity").
 pub fn segment(cloud: &PointCloud, config: &SegmentConfig) -> Result<Segmentation, SegmentError> {
+    segment_with_threads(cloud, config, NonZeroUsize::MIN)
+}
+
+/// [`segment`] with the seeds of a large organised cloud (at least 50,000 points per thread)
+/// computed on up to `threads` threads (one: no thread is started). The segmentation does not
+/// depend on the count.
+///
+/// # Errors
+/// As [`segment`].
+pub fn segment_with_threads(
+    cloud: &PointCloud,
+    config: &SegmentConfig,
+    threads: NonZeroUsize,
+) -> Result<Segmentation, SegmentError> {
     config.validate()?;
     match cloud.grid() {
         Some(grid) if !cloud.is_empty() => {
             let graph = Graph::grid(grid, cloud.positions(), config);
-            Ok(grow(cloud.positions(), &graph, config, up(cloud)))
+            Ok(grow(cloud.positions(), &graph, config, up(cloud), threads))
         }
         _ => segment_unorganised(cloud, config),
     }
@@ -584,7 +602,7 @@ pub fn segment_unorganised(
         return Ok(Segmentation::default());
     }
     let graph = Graph::knn(cloud.positions(), config.knn, config.knn_radius);
-    Ok(grow(cloud.positions(), &graph, config, up(cloud)))
+    Ok(grow(cloud.positions(), &graph, config, up(cloud), NonZeroUsize::MIN))
 }
 
 /// Neighbourhoods of the points: pixel grid or k-NN lists.
@@ -1210,55 +1228,30 @@ impl Seed {
     }
 }
 
-struct Grown {
-    points: Vec<u32>,
-    acc: PlaneAccumulator,
-}
-
-fn grow(points: &[Point3], graph: &Graph<'_>, config: &SegmentConfig, up: Vector3) -> Segmentation {
-    grow_counted(points, graph, config, up).0
-}
-
-/// [`grow`], and how many times a point was taken by a region (growth work: dissolved
-/// regions count again when their points are taken anew).
-fn grow_counted(
+/// The seeds of points `range` (module docs, step 3, and "Performance": certified bounds where
+/// they exist) and, with the normal test, their windows' normals and how far they may be from
+/// the fitted ones (index `i - range.start`).
+fn seeds_in(
+    range: std::ops::Range<usize>,
     points: &[Point3],
     graph: &Graph<'_>,
-    config: &SegmentConfig,
-    up: Vector3,
-) -> (Segmentation, usize) {
-    let n = points.len();
-    let range: Vec<Real> = points.iter().map(|p| p.coords.norm()).collect();
-    let sigma: Vec<Real> = range.iter().map(|&r| config.noise.sigma(r)).collect();
-    let tests = Tests { points, range, sigma, config, up };
+    tests: &Tests<'_>,
+    with_normals: bool,
+) -> (Vec<Seed>, Vec<(Vector3, Real)>) {
     let origin = Point3::origin();
-    let min_normal_cos = config.max_normal_angle.map_or(-1.0, Real::cos);
-
-    // Seed order: flattest windows first. Most seeds are never tried (their point or window
-    // is taken by then), so a window's plane is fitted only when it must be: with certified
-    // bounds on its curvature and normal ([`PlaneAccumulator::certified_plane`]) a seed is
-    // queued at its curvature's lower bound and fitted when it comes up with its point and
-    // window still free, then tried at once if no other seed comes before its exact
-    // curvature, else queued again at its exact curvature; the normal test fits
-    // a window only when the bound cannot decide it. Taken points stay taken between seeds
-    // (a dissolved region frees only the points it took), so a seed skipped early would be
-    // skipped at its exact turn too, and seeds are tried in exactly the order of their
-    // fitted curvatures (ties by index).
+    let offset = range.start;
     let mut window = Vec::new();
     let mut seeds: Vec<Seed> = Vec::new();
-    // Per point: its seed window's plane normal (zero without a complete window, which
-    // passes the normal test) and how far it may be from the fitted one (0: fitted).
-    let mut window_normal =
-        vec![(Vector3::zeros(), 0.0); if config.max_normal_angle.is_some() { n } else { 0 }];
+    let mut normals = vec![(Vector3::zeros(), 0.0); if with_normals { range.len() } else { 0 }];
     let mut members = [0u32; WINDOW_CAPACITY];
-    for i in 0..n {
+    for i in range {
         // Grid windows straight from the pixels; others (k-NN lists, wide windows) as listed.
         let (chained, acc) = match graph.grid_window(i, &mut members) {
             GridWindow::Members(len, chained) => {
                 let members = &members[..len];
                 if chained && let Some(bound) = certified_window_plane(points, members) {
                     seeds.push(Seed::new(bound.curvature_lower, i as u32, false));
-                    if let Some(slot) = window_normal.get_mut(i) {
+                    if let Some(slot) = normals.get_mut(i - offset) {
                         *slot = (bound.normal, bound.normal_error);
                     }
                     continue;
@@ -1283,7 +1276,7 @@ fn grow_counted(
         };
         if chained && let Some(bound) = acc.certified_plane() {
             seeds.push(Seed::new(bound.curvature_lower, i as u32, false));
-            if let Some(slot) = window_normal.get_mut(i) {
+            if let Some(slot) = normals.get_mut(i - offset) {
                 *slot = (bound.normal, bound.normal_error);
             }
             continue;
@@ -1300,11 +1293,88 @@ fn grow_counted(
                 }
             }
             seeds.push(Seed::new(fit.curvature(), i as u32, true));
-            if let Some(slot) = window_normal.get_mut(i) {
+            if let Some(slot) = normals.get_mut(i - offset) {
                 *slot = (fit.plane.normal.into_inner(), 0.0);
             }
         }
     }
+    (seeds, normals)
+}
+
+struct Grown {
+    points: Vec<u32>,
+    acc: PlaneAccumulator,
+}
+
+fn grow(
+    points: &[Point3],
+    graph: &Graph<'_>,
+    config: &SegmentConfig,
+    up: Vector3,
+    threads: NonZeroUsize,
+) -> Segmentation {
+    grow_counted(points, graph, config, up, threads).0
+}
+
+/// The fewest points per thread for which [`grow`] computes seeds on several threads.
+const PARALLEL_SEEDS_MIN: usize = 50_000;
+
+/// [`grow`], and how many times a point was taken by a region (growth work: dissolved
+/// regions count again when their points are taken anew).
+fn grow_counted(
+    points: &[Point3],
+    graph: &Graph<'_>,
+    config: &SegmentConfig,
+    up: Vector3,
+    threads: NonZeroUsize,
+) -> (Segmentation, usize) {
+    let n = points.len();
+    let range: Vec<Real> = points.iter().map(|p| p.coords.norm()).collect();
+    let sigma: Vec<Real> = range.iter().map(|&r| config.noise.sigma(r)).collect();
+    let tests = Tests { points, range, sigma, config, up };
+    let origin = Point3::origin();
+    let min_normal_cos = config.max_normal_angle.map_or(-1.0, Real::cos);
+
+    // Seed order: flattest windows first. Most seeds are never tried (their point or window
+    // is taken by then), so a window's plane is fitted only when it must be: with certified
+    // bounds on its curvature and normal ([`PlaneAccumulator::certified_plane`]) a seed is
+    // queued at its curvature's lower bound and fitted when it comes up with its point and
+    // window still free, then tried at once if no other seed comes before its exact
+    // curvature, else queued again at its exact curvature; the normal test fits
+    // a window only when the bound cannot decide it. Taken points stay taken between seeds
+    // (a dissolved region frees only the points it took), so a seed skipped early would be
+    // skipped at its exact turn too, and seeds are tried in exactly the order of their
+    // fitted curvatures (ties by index).
+    // Per point: its seed window's plane normal (zero without a complete window, which
+    // passes the normal test) and how far it may be from the fitted one (0: fitted).
+    // Large clouds share the points among `threads` threads; the seeds are sorted below, so
+    // the order does not depend on the split.
+    let with_normals = config.max_normal_angle.is_some();
+    let parts = threads.get().min(n.div_ceil(PARALLEL_SEEDS_MIN)).max(1);
+    let (mut seeds, mut window_normal) = if parts <= 1 {
+        seeds_in(0..n, points, graph, &tests, with_normals)
+    } else {
+        let chunk = n.div_ceil(parts);
+        let tests = &tests;
+        std::thread::scope(|s| {
+            let handles: Vec<_> = (1..parts)
+                .map(|k| {
+                    let range = k * chunk..((k + 1) * chunk).min(n);
+                    s.spawn(move || seeds_in(range, points, graph, tests, with_normals))
+                })
+                .collect();
+            let (mut seeds, mut normals) = seeds_in(0..chunk, points, graph, tests, with_normals);
+            for h in handles {
+                // A worker panics only if `seeds_in` does, which it would here too.
+                let (more, more_normals) =
+                    h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+                seeds.extend(more);
+                normals.extend(more_normals);
+            }
+            (seeds, normals)
+        })
+    };
+    let mut window = Vec::new();
     // Flattest first, ties by index: the keys are distinct (one per point), so an unstable
     // sort on the integer image of `total_cmp` gives the same order as a stable one.
     seeds.sort_unstable();
@@ -1568,7 +1638,8 @@ mod tests {
         let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
         let config = SegmentConfig::alrf();
         let graph = Graph::grid(cloud.grid().unwrap(), cloud.positions(), &config);
-        let (seg, taken) = grow_counted(cloud.positions(), &graph, &config, up(&cloud));
+        let (seg, taken) =
+            grow_counted(cloud.positions(), &graph, &config, up(&cloud), NonZeroUsize::MIN);
         let n = cloud.len();
         assert!(seg.regions.is_empty(), "{} regions", seg.regions.len());
         assert_eq!(seg.remainder.len(), n);

@@ -6,11 +6,12 @@ use patch_core::{Isometry3, Plane, PlaneCovariance, Point2, Point3, Polygon, Rea
 use patch_extract::PlanarRegion;
 use patch_extract::alpha_shape::{
     AlphaChoice, AlphaShapeConfig, AlphaShapeError, ComponentPolicy, HoleFilter,
-    ROBUST_MAX_UNCOVERED, alpha_shape, optimal_alpha,
+    ROBUST_MAX_UNCOVERED, alpha_shape, alpha_shape_filled, optimal_alpha,
 };
 use patch_extract::hull::{HullError, convex_hull, convex_hull_polygon};
 use patch_extract::polygonize::{
-    PolygonizeConfig, PolygonizeError, polygonize_region, region_to_patch, triangle_count,
+    GridThinning, PolygonizeConfig, PolygonizeError, pixels_of_points, polygonize_region,
+    region_to_patch, triangle_count,
 };
 use patch_extract::projection::{
     AlrfSideColumns, GrazingPolicy, ProjectionConfig, ProjectionError,
@@ -547,6 +548,42 @@ fn region_to_patch_of_a_scanned_wall_has_the_visible_area() {
     // The hull covers the window too.
     let hull = region_to_patch(&cloud, &region, &PolygonizeConfig::convex_hull()).unwrap();
     assert!(rel(hull[0].area(), 3.0) < 0.10, "hull area {}", hull[0].area());
+}
+
+/// Thinning on the pixel grid keeps a band along the wall's outline and around its window,
+/// and a sparse lattice inside: the outline is the thesis's up to a few per mille of area,
+/// the window stays a hole, and the α-shape sees a fraction of the points.
+#[test]
+fn thinned_outline_of_a_scanned_wall_matches_the_thesis() {
+    let config =
+        RangeCameraConfig { width: 352, height: 288, ..RangeCameraConfig::swissranger_sr3000() };
+    let (cloud, region) = scanned_wall(config, 3.0);
+    let thesis = polygonize_region(&cloud, &region, &PolygonizeConfig::thesis()).unwrap();
+    let thinned = polygonize_region(&cloud, &region, &PolygonizeConfig::thinned()).unwrap();
+    let (a, b) = (&thesis.patches[0], &thinned.patches[0]);
+    assert!(rel(b.area(), a.area()) < 0.005, "area {} vs {}", b.area(), a.area());
+    assert_eq!(b.polygon().holes().len(), 1, "the window stays a hole");
+    let alpha = (thesis.alpha.unwrap(), thinned.alpha.unwrap());
+    assert!(rel(alpha.1, alpha.0) < 0.05, "α {alpha:?}");
+    let grid = cloud.grid().unwrap();
+    let (band, fill) = GridThinning::standard()
+        .split(grid, &pixels_of_points(grid, cloud.len()), &region.points)
+        .unwrap();
+    assert!(band.len() + fill.len() < region.points.len() / 2, "{} + {}", band.len(), fill.len());
+    assert!(band.iter().chain(&fill).all(|p| region.points.binary_search(p).is_ok()));
+}
+
+/// Without fill points the filled α-shape is the α-shape.
+#[test]
+fn alpha_shape_filled_without_fill_is_the_alpha_shape() {
+    let points: Vec<Point2> = (0..400)
+        .map(|k| {
+            let (i, j) = ((k % 20) as Real, (k / 20) as Real);
+            Point2::new(i + 0.3 * (j * 1.7).sin(), j + 0.3 * (i * 2.3).cos())
+        })
+        .collect();
+    let config = AlphaShapeConfig::thesis();
+    assert_eq!(alpha_shape_filled(&points, &[], &config), alpha_shape(&points, &config));
 }
 
 #[test]

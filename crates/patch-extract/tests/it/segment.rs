@@ -499,3 +499,33 @@ fn the_second_pass_leaves_an_unorganised_cloud_alone() {
     assert_eq!(segment_remainder(&cloud, &mut seg, &SegmentConfig::alrf_second_pass()).unwrap(), 0);
     assert_eq!(seg, before);
 }
+
+/// Seeds computed on several threads give the segmentation of one thread, bit for bit, on a
+/// VGA frame (above the per-thread minimum) with the normal test on (its window normals are
+/// split among the threads too).
+#[test]
+fn segmentation_does_not_depend_on_the_thread_count() {
+    let camera = RangeCamera::new(RangeCameraConfig {
+        width: 480,
+        height: 360,
+        ..RangeCameraConfig::swissranger_sr3000()
+    })
+    .unwrap();
+    let cloud = camera.scan(&corner_scene(), &camera_pose(), 3).to_cloud().unwrap();
+    assert!(cloud.len() > 150_000, "{} points", cloud.len());
+    let config = SegmentConfig {
+        max_normal_angle: Some(60f64.to_radians()),
+        ..SegmentConfig::range_camera()
+    };
+    let one = segment(&cloud, &config).unwrap();
+    assert!(one.regions.len() >= 4, "{} regions", one.regions.len());
+    for threads in [2, 3] {
+        let many = patch_extract::segment_with_threads(
+            &cloud,
+            &config,
+            std::num::NonZeroUsize::new(threads).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(many, one, "{threads} threads");
+    }
+}
