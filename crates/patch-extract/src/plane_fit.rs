@@ -371,7 +371,7 @@ pub(crate) fn certified_window_plane(points: &[Point3], members: &[u32]) -> Opti
 
 /// The bounds of [`PlaneAccumulator::certified_plane`] from a scatter matrix `m` (of at least
 /// three points; symmetric up to rounding).
-fn certify(m: &Matrix3<Real>) -> Option<CertifiedPlane> {
+pub(crate) fn certify(m: &Matrix3<Real>) -> Option<CertifiedPlane> {
     if !m.iter().all(|e| e.is_finite()) {
         return None;
     }
