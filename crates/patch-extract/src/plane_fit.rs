@@ -261,6 +261,26 @@ impl PlaneAccumulator {
         Some((normal.dot(&(s * normal)) / self.count as Real).max(0.0))
     }
 
+    /// For a unit `normal`: `(Σ dᵢ, Σ dᵢ²)` with `dᵢ = normal · (xᵢ − r)` for the points'
+    /// reference `r` ([`PlaneAccumulator::offset_along`]). With them, `nᵀ S n` of the points
+    /// plus one more at offset `d` is `Σ dᵢ² + d² − (Σ dᵢ + d)² / (n + 1)` in O(1)
+    /// ([`PlaneAccumulator::mse_along`] without the scatter matrix). O(1).
+    pub(crate) fn moments_along(&self, normal: &Vector3) -> (Real, Real) {
+        let s = &self.sum_sq;
+        let (x, y, z) = (normal.x, normal.y, normal.z);
+        let quadratic = x * x * s[0]
+            + y * y * s[3]
+            + z * z * s[5]
+            + 2.0 * (x * y * s[1] + x * z * s[2] + y * z * s[4]);
+        (normal.dot(&self.sum), quadratic)
+    }
+
+    /// `normal · (p − r)` for the points' reference `r` (see
+    /// [`PlaneAccumulator::moments_along`]).
+    pub(crate) fn offset_along(&self, normal: &Vector3, p: &Point3) -> Real {
+        normal.dot(&(p.coords - self.reference))
+    }
+
     /// The least-squares plane, normal oriented toward `viewpoint`. `None` with fewer than
     /// three points or when the points are (numerically) collinear or coincident, i.e. when
     /// the middle eigenvalue is at most `1e-12` times the largest.
