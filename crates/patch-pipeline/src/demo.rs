@@ -258,11 +258,11 @@ pub fn run(scale: Scale, seed: u64, out: &Path, progress: &dyn Progress) -> Resu
     clock.lap("terrain: simulate, classify");
 
     let spinner = progress.spinner("scanning the lab");
-    let lab = maps::scan_lab(seed, &settings, &mut files)?;
+    let (lab, clouds) = maps::scan_lab(seed, &settings, &mut files)?;
     spinner.finish_and_clear();
     clock.lap("lab: simulate ALRF scans");
 
-    let built = maps::build_maps(&lab, progress, &mut files)?;
+    let built = maps::build_maps(clouds, progress, &mut files)?;
     clock.lap("patch extraction and maps");
 
     let spinner = progress.spinner("checking the maps against the scene");

@@ -25,20 +25,25 @@ pub fn plan_backend(_kind: MapKind) -> Backend {
     Backend::Trimesh
 }
 
-/// The scanned lab.
+/// The scanned lab (its scans are returned beside it by [`scan_lab`], for [`build_maps`] to
+/// consume).
 pub struct Lab {
     /// The scene.
     pub scene: Scene,
-    /// Organised scans in the sensor frame with their poses (the ±90° columns dropped).
-    pub clouds: Vec<PointCloud>,
     /// Scanner positions.
     pub positions: Vec<Point3>,
     /// Points of all scans.
     pub points: usize,
 }
 
-/// Simulates the lab's ALRF scans and writes each (`scan-N.ply`, sensor frame with its pose).
-pub fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Result<Lab> {
+/// Simulates the lab's ALRF scans and writes each (`scan-N.ply`, sensor frame with its pose):
+/// the lab, and its organised scans in the sensor frame with their poses (the ±90° columns
+/// dropped).
+pub fn scan_lab(
+    seed: u64,
+    settings: &Settings,
+    files: &mut Files,
+) -> Result<(Lab, Vec<PointCloud>)> {
     let scene = scene_sim::lab(seed).context("building the lab scene")?;
     let setup =
         ScanSetup { scans: settings.scans, height: SCAN_HEIGHT, step_deg: None, seed, noise: 1.0 };
@@ -53,7 +58,7 @@ pub fn scan_lab(seed: u64, settings: &Settings, files: &mut Files) -> Result<Lab
         write_ply_f32(&files.path(&name), cloud)?;
         files.add(format!("ALRF scan {} (sensor frame, with its pose)", i + 1), &name)?;
     }
-    Ok(Lab { scene, clouds, positions, points })
+    Ok((Lab { scene, positions, points }, clouds))
 }
 
 /// Everything built from the scans.
@@ -211,17 +216,22 @@ pub fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
     Ok((vertices, faces))
 }
 
-/// Extracts the planes, hybrid and trimesh maps' patches from the scans, loads each into every
-/// patch backend (keeping the planning backend's), builds the pc map, and writes each map's
-/// 3D file (`map-KIND.ply`).
-pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Result<Built> {
+/// Extracts the planes, hybrid and trimesh maps' patches from the scans `clouds` (of
+/// [`scan_lab`]), loads each into every patch backend (keeping the planning backend's), builds
+/// the pc map, and writes each map's 3D file (`map-KIND.ply`). The scans are dropped once the
+/// pc map's points are taken from them, before its map is built (the demo's memory peak).
+pub fn build_maps(
+    clouds: Vec<PointCloud>,
+    progress: &dyn Progress,
+    files: &mut Files,
+) -> Result<Built> {
     let kinds = [MapKind::Planes, MapKind::Hybrid, MapKind::Trimesh];
     let bar =
         progress.bar((kinds.len() * (Backend::patch_backends().count() + 1) + 1) as u64, "maps");
     let mut built = Built { maps: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
     for kind in kinds {
         let t0 = Instant::now();
-        let patches = extracted_patches(&lab.clouds, kind)
+        let patches = extracted_patches(&clouds, kind)
             .with_context(|| format!("extracting the {kind} map"))?
             .context("a patch map has patches")?;
         let extraction = t0.elapsed().as_secs_f64();
@@ -274,7 +284,9 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
         built.rows.extend(rows.into_iter().map(|(_, row)| row));
     }
     let t0 = Instant::now();
-    let points: Vec<Point3> = crate::scene_map::pc_points(&lab.clouds, &Default::default())?;
+    let points: Vec<Point3> = crate::scene_map::pc_points(&clouds, &Default::default())?;
+    let scans = clouds.len();
+    drop(clouds);
     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
     let build_seconds = t0.elapsed().as_secs_f64();
     let (row, drawing) = point_map_entry(&map, &points, build_seconds)?;
@@ -290,7 +302,7 @@ pub fn build_maps(lab: &Lab, progress: &dyn Progress, files: &mut Files) -> Resu
         planar_patches: 0,
         trimesh_patches: 0,
         triangles: 0,
-        point_clouds: lab.clouds.len(),
+        point_clouds: scans,
         points: points_len,
     });
     bar.inc(1);
