@@ -201,9 +201,17 @@ fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<(Vec<PointCloud
     let names = args.scans.iter().map(|p| p.display().to_string()).collect();
     let poses = args.poses.as_deref().map(read_poses).transpose()?;
     let bar = progress.bar(args.scans.len() as u64, "reading");
+    // The files are read on the extraction's threads, in order (the first error is the first
+    // file's that fails, as one thread would report it).
+    let threads = patch_pipeline::parallel::threads_or_cores(args.threads);
+    let read = patch_pipeline::parallel::map_in_order(args.scans.len(), threads, |i| {
+        let cloud = crate::input::read_cloud(&args.scans[i], &args.input);
+        bar.inc(1);
+        cloud
+    });
     let mut scans = Vec::with_capacity(args.scans.len());
-    for path in &args.scans {
-        let mut cloud = crate::input::read_cloud(path, &args.input)?;
+    for (path, cloud) in args.scans.iter().zip(read) {
+        let mut cloud = cloud?;
         if let Some(poses) = &poses {
             let name = path.file_name().map(|f| f.to_string_lossy().into_owned());
             let pose = name
@@ -213,7 +221,6 @@ fn read_scans(args: &ExtractArgs, progress: &Progress) -> Result<(Vec<PointCloud
             cloud.set_sensor_pose(Some(SensorPose { world_from_sensor: *pose }));
         }
         scans.push(cloud);
-        bar.inc(1);
     }
     bar.finish_and_clear();
     Ok((scans, names))
@@ -248,9 +255,7 @@ pub fn run(args: &ExtractArgs, progress: &Progress) -> Result<()> {
     let rss_after_load = peak_rss_kib();
     let config = config(args);
     let bar = progress.bar(scans.len() as u64, "extracting");
-    let threads = args
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().unwrap_or(NonZeroUsize::MIN));
+    let threads = patch_pipeline::parallel::threads_or_cores(args.threads);
     let result = extract_with_threads(&scans, &config, threads, |_| bar.inc(1))?;
     bar.finish_and_clear();
 
