@@ -16,7 +16,8 @@
 //!
 //! The mesh is also a parry [`Shape`] (of type [`ShapeType::Custom`]): the rapier map's
 //! colliders hold it, so both maps store triangles the same compact way and answer through
-//! [`IndexedMesh`] with one narrow phase.
+//! the same walks ([`CompactMesh::any_triangle`], [`CompactMesh::find_best`]) with one narrow
+//! phase.
 
 use parry3d_f64::bounding_volume::{Aabb as BoxAabb, BoundingSphere};
 use parry3d_f64::mass_properties::MassProperties;
@@ -39,26 +40,6 @@ const BINS: usize = 16;
 /// The walks' stack: deeper than any tree [`CompactMesh::build`] makes (at most
 /// `SAH_DEPTH + 32` levels for `u32` triangle indices).
 const STACK: usize = 96;
-
-/// Triangles with a bounding volume hierarchy over them, queried by the maps' narrow phase.
-pub(crate) trait IndexedMesh {
-    /// Triangle `i`.
-    fn triangle(&self, i: u32) -> Triangle;
-
-    /// Whether `hit` holds for a triangle whose boxes all pass `visit` (a conservative test: a
-    /// box that fails it holds no triangle `hit` accepts).
-    fn any_triangle(&self, visit: impl Fn(&BoxAabb) -> bool, hit: impl FnMut(u32) -> bool) -> bool;
-
-    /// The triangle of least cost below `max_cost`: `aabb_cost(box, best)` is a lower bound of
-    /// the cost of every triangle in the box (`Real::MAX` if none can beat `best`),
-    /// `leaf_cost(triangle, best)` its cost if below `best`.
-    fn find_best<L: BvhLeafCost>(
-        &self,
-        max_cost: Real,
-        aabb_cost: impl Fn(&BoxAabb, Real) -> Real,
-        leaf_cost: impl Fn(u32, Real) -> Option<L>,
-    ) -> Option<(u32, L)>;
-}
 
 /// A node: an `f32` box rounded outwards; a leaf holds triangles `first..first + count`, an
 /// inner node (`count == 0`) has its children at `first` and `first + 1`.
@@ -395,13 +376,16 @@ fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     left
 }
 
-impl IndexedMesh for CompactMesh {
-    fn triangle(&self, i: u32) -> Triangle {
+impl CompactMesh {
+    /// Triangle `i`.
+    pub(crate) fn triangle(&self, i: u32) -> Triangle {
         let [a, b, c] = self.indices[i as usize].map(|v| self.vertices[v as usize]);
         Triangle::new(a, b, c)
     }
 
-    fn any_triangle(
+    /// Whether `hit` holds for a triangle whose boxes all pass `visit` (a conservative test: a
+    /// box that fails it holds no triangle `hit` accepts).
+    pub(crate) fn any_triangle(
         &self,
         visit: impl Fn(&BoxAabb) -> bool,
         mut hit: impl FnMut(u32) -> bool,
@@ -429,7 +413,10 @@ impl IndexedMesh for CompactMesh {
         false
     }
 
-    fn find_best<L: BvhLeafCost>(
+    /// The triangle of least cost below `max_cost`: `aabb_cost(box, best)` is a lower bound of
+    /// the cost of every triangle in the box (`Real::MAX` if none can beat `best`),
+    /// `leaf_cost(triangle, best)` its cost if below `best`.
+    pub(crate) fn find_best<L: BvhLeafCost>(
         &self,
         max_cost: Real,
         aabb_cost: impl Fn(&BoxAabb, Real) -> Real,

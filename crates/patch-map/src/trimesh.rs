@@ -96,7 +96,7 @@ use patch_core::{
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::Backend;
-use crate::compact_mesh::{CompactMesh, IndexedMesh};
+use crate::compact_mesh::CompactMesh;
 use crate::mapfile::{MapCounts, MapFileError, read_map, write_map};
 use crate::persist::{MapFile, MemoryUsage, patch_counts, patches_memory_bytes};
 use crate::triangulate::{TriangulationError, triangulate_polygon};
@@ -528,16 +528,12 @@ impl Probe {
     }
 
     /// Whether the probe touches a triangle of the mesh.
-    pub(crate) fn touches_mesh(&self, mesh: &impl IndexedMesh) -> bool {
+    pub(crate) fn touches_mesh(&self, mesh: &CompactMesh) -> bool {
         mesh.any_triangle(|aabb| self.may_touch(aabb), |tri| self.touches(&mesh.triangle(tri)))
     }
 
     /// The first triangle of the mesh the probe touches before `bound`: `(triangle, t)`.
-    pub(crate) fn first_in_mesh(
-        &self,
-        mesh: &impl IndexedMesh,
-        bound: Real,
-    ) -> Option<(u32, Real)> {
+    pub(crate) fn first_in_mesh(&self, mesh: &CompactMesh, bound: Real) -> Option<(u32, Real)> {
         mesh.find_best(
             bound,
             |aabb, best| self.box_entry(aabb, best),
@@ -548,11 +544,7 @@ impl Probe {
 
 /// The triangle of the mesh nearest to `point`, if closer than `bound`: `(triangle, closest
 /// point, distance)` (best-first over the boxes, parry's point projection on the triangles).
-fn mesh_nearest(
-    mesh: &impl IndexedMesh,
-    point: &Point3,
-    bound: Real,
-) -> Option<(u32, Point3, Real)> {
+fn mesh_nearest(mesh: &CompactMesh, point: &Point3, bound: Real) -> Option<(u32, Point3, Real)> {
     let (tri, (d, q)) = mesh.find_best(
         bound,
         |aabb, _| aabb.distance_to_local_point(point, true),
@@ -567,7 +559,7 @@ fn mesh_nearest(
 /// The closest point of a mesh to `point` among the triangles accepted by `keep`, starting
 /// from triangle `first` (which must be accepted): `(triangle, point, distance)`.
 pub(crate) fn closest_on_triangles(
-    mesh: &impl IndexedMesh,
+    mesh: &CompactMesh,
     point: &Point3,
     first: u32,
     keep: impl Fn(u32) -> bool,
@@ -588,7 +580,7 @@ pub(crate) fn closest_on_triangles(
 /// The hit of a step on `patch` at `t`, whose triangles in `mesh` are those accepted by
 /// `keep`; `tri` is one of them touched at `t`.
 pub(crate) fn complete_hit<S: Step>(
-    mesh: &impl IndexedMesh,
+    mesh: &CompactMesh,
     tri: u32,
     keep: impl Fn(u32) -> bool,
     id: PatchId,
