@@ -285,7 +285,69 @@ pub fn page(m: &Matrix, svg_name: &str) -> Result<String> {
         o.push_str(&scans);
     }
     o.push('\n');
+    o.push_str(&backend_ratios(m)?);
+    o.push('\n');
     o.push_str(&volume::volume_section(&m.volume));
+    Ok(o)
+}
+
+/// Per scene and patch backend, the largest ratio of its median time to the fastest patch
+/// backend's over the scene's planners and times (the whole run, K = 100 and K = 500), with
+/// where it occurs: the figures behind the crate docs' advice on which backend to pick.
+fn backend_ratios(m: &Matrix) -> Result<String> {
+    const TIMES: [(&str, &str); 3] =
+        [("time", ""), ("time_k100", " K=100"), ("time_k500", " K=500")];
+    let patch = &BACKENDS[..4];
+    let scenes: BTreeSet<&str> = m.cells.keys().map(|(s, _, _)| s.as_str()).collect();
+    let mut o = String::new();
+    writeln!(o, "## Which backend: time against the fastest\n")?;
+    writeln!(
+        o,
+        "Per scene, each patch backend's largest ratio of its median time to the fastest patch \
+         backend's, over the scene's planners and times (the whole run; K = 100 and 500 on the \
+         lab scenes), with the planner where it occurs: the figures behind `patch-map`'s advice \
+         on which backend to pick (crate docs, \"Which one to pick\").\n"
+    )?;
+    writeln!(
+        o,
+        "| scene | {} |",
+        patch.iter().map(|(b, _)| b.name()).collect::<Vec<_>>().join(" | ")
+    )?;
+    writeln!(o, "|---|{}", "---|".repeat(patch.len()))?;
+    for scene in scenes {
+        // Per backend: the worst ratio and where.
+        let mut worst: Vec<Option<(f64, String)>> = vec![None; patch.len()];
+        for (planner, label) in PLANNERS {
+            for (metric, k) in TIMES {
+                let medians: Vec<Option<f64>> = patch
+                    .iter()
+                    .map(|&(b, _)| quantile(&m.values(scene, b, planner, metric), 0.5))
+                    .collect();
+                let Some(best) = medians.iter().flatten().copied().min_by(f64::total_cmp) else {
+                    continue;
+                };
+                if best.is_nan() || best <= 0.0 {
+                    continue;
+                }
+                for (slot, median) in worst.iter_mut().zip(&medians) {
+                    if let Some(v) = median {
+                        let ratio = v / best;
+                        if slot.as_ref().is_none_or(|(w, _)| ratio > *w) {
+                            *slot = Some((ratio, format!("{label}{k}")));
+                        }
+                    }
+                }
+            }
+        }
+        if worst.iter().all(Option::is_none) {
+            continue;
+        }
+        let cells: Vec<String> = worst
+            .iter()
+            .map(|w| w.as_ref().map_or("–".to_owned(), |(r, at)| format!("×{:.2} ({at})", r)))
+            .collect();
+        writeln!(o, "| {scene} | {} |", cells.join(" | "))?;
+    }
     Ok(o)
 }
 
@@ -355,6 +417,19 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("RRT on rapier: 4.50 ms"));
         assert!(page_of_nothing_fails());
+    }
+
+    #[test]
+    fn backend_ratios_give_each_backends_worst_ratio_to_the_fastest() {
+        let mut rows = Vec::new();
+        for (backend, rrt, prm) in [("polygon", 1.0, 4.0), ("bbox6d", 3.0, 2.0)] {
+            for (planner, time) in [("rrt", rrt), ("prm", prm)] {
+                rows.push(row("office", backend, planner, 0, "time", time, "r"));
+                rows.push(row("office", backend, planner, 0, "solved", 1.0, "r"));
+            }
+        }
+        let table = backend_ratios(&Matrix::from_rows(&rows)).unwrap();
+        assert!(table.contains("| office | ×2.00 (PRM) | ×3.00 (RRT) | – | – |"), "{table}");
     }
 
     #[test]

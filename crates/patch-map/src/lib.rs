@@ -45,32 +45,33 @@
 //! MA PRM) or specific hits (Evasion RRT) do not compile with it (thesis Table 5.2).
 //!
 //! # Which one to pick
-//! Measured on the benchmark matrix (`docs/benchmarks.md`: the office floor plan, the lab's
-//! exact geometry and the lab's four maps built from scans; every backend on the same map in
-//! one run) and on the generated voxel world (docs/performance.md). No backend is the fastest
-//! everywhere; each pick below is within 1.5× of the fastest on the scenes it names:
-//! * RRT, PRM and their relatives (they ask "is this step free?") on a map of a few hundred
-//!   planar patches (rooms, floor plans): [`BBox6dMap`]. Office, median time to the four goals
-//!   (`patchnav experiment office --seeds 10 --planners rrt,prm,evasion-rrt --threads 1`):
-//!   RRT 219 µs against polygon's 281 µs, trimesh's 342 µs and rapier's 540 µs; PRM 13.4 ms
-//!   against 15.7, 22.5 and 19.8 ms.
-//! * The same planners on maps built from scans, with trimesh patches or whole-scan meshes:
-//!   [`RapierMap`] (feature `rapier`, on by default), or [`TrimeshMap`] without the feature.
-//!   RRT, 500 iterations, on the lab's hybrid map from scans: rapier 1.84 ms, trimesh 2.17 ms,
-//!   bbox6d 9.62 ms, polygon 11.0 ms (the matrix's run before the patch backends' faster
-//!   capsule test, which gains them about 1.4× on such maps); on whole-scan meshes trimesh is
-//!   2.5× (RRT) to 4.7× (PRM) slower than rapier.
-//! * Large finished maps (tens of thousands of patches): [`TrimeshMap`]. On the generated
-//!   voxel world (`cargo xtask voxel-world`: 38,293 patches of very mixed sizes, 120,932
-//!   triangles) RRT takes 1.82 µs per iteration on it, 3.15 µs on [`BBox6dMap`] and 5.19 µs
-//!   on [`RapierMap`].
-//! * The Evasion RRT (it asks for the first contact of a step): [`BBox6dMap`] or [`PolygonMap`].
-//!   Office: 1.78 and 1.69 ms; trimesh 7.81 ms, rapier 9.83 ms.
+//! Measured on the benchmark matrix (`docs/benchmarks.md`, `cargo xtask bench roadmap --jobs 1`:
+//! the office floor plan with ten planners, the lab's exact geometry and the lab's maps built
+//! from scans with RRT and PRM; every backend on the same map in one run) and on the generated
+//! voxel world (docs/performance.md). No backend is the fastest everywhere; each pick below is
+//! within the stated factor of the fastest backend's median time on every planner of the
+//! matrix's scenes it names (at b2b3363):
+//! * A map of a few hundred planar patches (rooms, floor plans) with any planner: [`PolygonMap`].
+//!   Office, median time to the four goals: RRT 189 µs against bbox6d's 285 µs, rapier's 455 µs
+//!   and trimesh's 554 µs; within 1.35× of the fastest on all ten planners (RRT-Connect and
+//!   RRT*, where [`BBox6dMap`] is fastest). [`BBox6dMap`] is within 1.5× on eight of them (MA RRT
+//!   1.93×, RRT 1.50×).
+//! * Maps with trimesh patches or built from scans (the lab's exact geometry with its curved
+//!   objects; its planes, hybrid and trimesh maps from scans): [`RapierMap`] (feature `rapier`, on
+//!   by default), within 1.15× of the fastest on every case (RRT and PRM, K = 100, 500 and the
+//!   whole run). Without the feature, [`TrimeshMap`]: within 1.7× on the lab's maps, but 2.3–2.5×
+//!   slower than rapier for PRM on whole-scan meshes (the trimesh map).
+//! * Large finished maps of many planar patches of mixed sizes: [`TrimeshMap`]. On the generated
+//!   voxel world (`cargo xtask voxel-world`: 38,293 patches, 120,932 triangles; not in the
+//!   matrix) RRT takes 3.16 µs per iteration on it, 4.64 µs on [`BBox6dMap`] and 8.47 µs on
+//!   [`RapierMap`].
+//! * The Evasion RRT (it asks for the first contact of a step): [`PolygonMap`] or [`BBox6dMap`].
+//!   Office: 1.15 and 1.45 ms; rapier 6.66 ms, trimesh 7.74 ms.
 //! * Maps that grow while the robot explores (patches added between queries): [`BBox6dMap`];
 //!   adding stays exact and sublinear. Its k-d nodes keep the union of the patch boxes below
 //!   them, so maps of mixed patch sizes stay fast, but a large patch's box still makes it a
 //!   candidate for every step near it; prefer the mesh backends for a finished map.
-//! * Small maps, tests, or a second opinion: [`PolygonMap`] (every query is O(P)).
+//! * Tests, or a second opinion: [`PolygonMap`] (every query is O(P)).
 //! * Raw scans without patch extraction: [`PointCloudMap`], for RRT and PRM only, and only if
 //!   the scan is denser than the robot (see [`point_cloud`]).
 //!
