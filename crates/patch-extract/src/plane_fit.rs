@@ -281,6 +281,43 @@ impl PlaneAccumulator {
         normal.dot(&(p.coords - self.reference))
     }
 
+    /// [`PlaneFit::curvature`] of [`PlaneAccumulator::fit`] to within rounding, without its
+    /// eigendecomposition: the smallest eigenvalue by Newton's method on the characteristic
+    /// polynomial `det(S − λI)`, from the certified Rayleigh quotient just above it
+    /// ([`PlaneAccumulator::certified_plane`]; below the second eigenvalue, so the iteration
+    /// falls monotonically onto the smallest), over the scatter's trace. `None` where the
+    /// bounds are not certified. O(1).
+    pub(crate) fn polished_curvature(&self) -> Option<Real> {
+        if self.count < 3 {
+            return None;
+        }
+        let m = self.scatter()?;
+        let bound = certify(&m)?;
+        let sym = |i: usize, j: usize| 0.5 * (m[(i, j)] + m[(j, i)]);
+        let (a, b, c, d, e, f) = (sym(0, 0), sym(0, 1), sym(0, 2), sym(1, 1), sym(1, 2), sym(2, 2));
+        let trace = a + d + f;
+        let mut lambda = bound.lambda0_upper;
+        for _ in 0..4 {
+            let (ad, dd, fd) = (a - lambda, d - lambda, f - lambda);
+            let (m1, m2, m3) = (dd * fd - e * e, ad * fd - c * c, ad * dd - b * b);
+            let p = ad * m1 - b * (b * fd - c * e) + c * (b * e - c * dd);
+            let slope = -(m1 + m2 + m3);
+            if slope.is_nan() || slope >= 0.0 {
+                break;
+            }
+            let step = p / slope;
+            if !step.is_finite() {
+                break;
+            }
+            lambda -= step;
+            if step.abs() <= 1e-15 * trace {
+                break;
+            }
+        }
+        let curvature = lambda.max(0.0) / trace;
+        (curvature.is_finite() && trace > 0.0).then_some(curvature)
+    }
+
     /// The least-squares plane, normal oriented toward `viewpoint`. `None` with fewer than
     /// three points or when the points are (numerically) collinear or coincident, i.e. when
     /// the middle eigenvalue is at most `1e-12` times the largest.
@@ -334,6 +371,9 @@ pub(crate) struct CertifiedPlane {
     pub normal: Vector3,
     /// See `normal`.
     pub normal_error: Real,
+    /// At least the scatter's smallest eigenvalue (the Rayleigh quotient of `normal`), within
+    /// the certified distance of it.
+    pub lambda0_upper: Real,
 }
 
 impl PlaneAccumulator {
@@ -454,7 +494,12 @@ pub(crate) fn certify(m: &Matrix3<Real>) -> Option<CertifiedPlane> {
     let lower = lambda0_lower / total_upper * (1.0 - 1e-9);
     let curvature_lower = if lower > 0.0 && lower.is_finite() { lower } else { -0.0 };
     // sin θ ≤ `angle` < 1/2, so the chord 2 sin(θ/2) is below 1.04 `angle`.
-    Some(CertifiedPlane { curvature_lower, normal: v, normal_error: 1.05 * angle })
+    Some(CertifiedPlane {
+        curvature_lower,
+        normal: v,
+        normal_error: 1.05 * angle,
+        lambda0_upper: rayleigh,
+    })
 }
 
 /// `nalgebra::SymmetricEigen::new(m)` for a 3×3 matrix, bit for bit: the same operations in
@@ -757,6 +802,13 @@ mod tests {
                 let n = fit.plane.normal.into_inner();
                 let off = (bound.normal - n).norm().min((bound.normal + n).norm());
                 assert!(off <= bound.normal_error, "{k}: {off} > {}", bound.normal_error);
+            }
+            if let Some(polished) = acc.polished_curvature() {
+                let fitted = acc.fit(&Point3::origin()).expect("certified planes have a fit");
+                let lower = acc.certified_plane().expect("polished needs bounds").curvature_lower;
+                assert!(lower <= polished, "{k}: {lower} > {polished}");
+                let error = (polished - fitted.curvature()).abs();
+                assert!(error <= 1e-12, "{k}: {polished} against {}", fitted.curvature());
             }
         }
         assert!(certified > 20_000, "{certified}");

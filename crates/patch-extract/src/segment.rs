@@ -96,8 +96,13 @@
 //! and the normal test start from certified bounds on each window's curvature and normal
 //! (one cheap power step on the adjugate of the scatter matrix, with interlacing and
 //! Davis–Kahan/Kato–Temple error bounds), and a window is fitted exactly (3×3 eigenproblem)
-//! only when its seed comes up untaken or its bound cannot decide the normal test. The
-//! segmentation is exactly that of fitting every window first (same regions, same bits).
+//! only when its seed is tried or its bound cannot decide the normal test. A seed that comes
+//! up untaken gets its exact curvature from Newton's method on the characteristic polynomial
+//! (equal to the fit's to within 10⁻¹² and certified above its bound,
+//! `PlaneAccumulator::polished_curvature`), and waits at it if another seed comes first.
+//! The segmentation is that of fitting every window first (the same regions on every input
+//! of `cargo xtask compare segmentation` and the lab's scans; seeds whose curvatures agree to
+//! 10⁻¹² could in principle swap).
 //! Release build, one core of a shared 2-core machine: a simulated 541 × 361 ALRF scan of
 //! scene-sim's lab (≈ 190,000 points, 3 cm noise) takes ≈ 95 ms, ≈ 215 ms with every window
 //! fitted up front, `atan2` for every seed stride and the generic eigensolver (measured with
@@ -108,7 +113,10 @@
 //! their moments from separable box sums over tiles of pixels ("integral images", relative to
 //! a point of each tile; not in the thesis) instead of summing each window's points: on the
 //! Kinect office frame and the floor-plan scan this cut the segmentation's time by about a
-//! quarter. The bounds stay certified, so the segmentation is again the same.
+//! quarter. The bounds stay certified, so the segmentation is again the same. A window whose
+//! bounds fail (nearly equal smallest eigenvalues: curved or noisy windows, late in the seed
+//! order) is queued at a weaker floor of its curvature (`4 det / tr³`) instead of being fitted
+//! up front.
 //!
 //! The seeds' bounds are independent per point: [`segment_with_threads`] (and the pipeline,
 //! with the cores its scans leave free) computes them for large organised clouds on several
@@ -1362,6 +1370,24 @@ fn seed_of(
     Some((Seed::new(fit.curvature(), i as u32, true), (fit.plane.normal.into_inner(), 0.0)))
 }
 
+/// A lower bound of the surface variation `λ₀ / (λ₀ + λ₁ + λ₂)` of a scatter matrix for the
+/// windows whose certified bounds fail (nearly equal smallest eigenvalues: curved or noisy
+/// windows, late in the seed order): `λ₀ = det / (λ₁ λ₂) ≥ 4 det / tr²` since
+/// `λ₁ λ₂ ≤ ((λ₁ + λ₂) / 2)² ≤ (tr / 2)²`, with slack for rounding (the box sums' error
+/// included, [`BOX_SUM_MAX_SPREAD`]). Such a seed is fitted only if it comes up untaken. `None`
+/// for a non-finite or zero matrix.
+fn curvature_floor(m: &Matrix3<Real>) -> Option<Real> {
+    let norm: Real = m.iter().map(|x| x.abs()).sum();
+    let trace = m.trace();
+    if !(norm.is_finite() && norm > 0.0 && trace > 0.0) {
+        return None;
+    }
+    let slack = 1e-10 * norm;
+    let det = m.determinant() - slack * norm * norm;
+    let total = trace + 3.0 * slack;
+    Some((4.0 * det / (total * total * total)).max(0.0) * (1.0 - 1e-9))
+}
+
 /// Side of the square tiles of window centres in [`seeds_in_rows`], pixels.
 const TILE: usize = 32;
 
@@ -1485,15 +1511,16 @@ fn seeds_in_rows(
                                 Matrix3::new(t[4], t[5], t[6], t[5], t[7], t[8], t[6], t[8], t[9]);
                             let scatter = raw - m * sum.transpose();
                             let spread = t[4] + t[7] + t[9];
-                            (spread <= BOX_SUM_MAX_SPREAD * scatter.trace())
-                                .then(|| certify(&scatter))
-                                .flatten()
+                            (spread <= BOX_SUM_MAX_SPREAD * scatter.trace()).then(|| {
+                                certify(&scatter)
+                                    .map(|bound| bound.curvature_lower)
+                                    .or_else(|| curvature_floor(&scatter))
+                            })
                         })
+                        .flatten()
                         .flatten();
                     match bound {
-                        Some(bound) => {
-                            seeds.push(Seed::new(bound.curvature_lower, i as u32, false))
-                        }
+                        Some(lower) => seeds.push(Seed::new(lower, i as u32, false)),
                         None => {
                             if let Some((seed, _)) = seed_of(i, points, graph, tests, &mut scratch)
                             {
@@ -1547,13 +1574,13 @@ fn grow_counted(
     // Seed order: flattest windows first. Most seeds are never tried (their point or window
     // is taken by then), so a window's plane is fitted only when it must be: with certified
     // bounds on its curvature and normal ([`PlaneAccumulator::certified_plane`]) a seed is
-    // queued at its curvature's lower bound and fitted when it comes up with its point and
-    // window still free, then tried at once if no other seed comes before its exact
-    // curvature, else queued again at its exact curvature; the normal test fits
-    // a window only when the bound cannot decide it. Taken points stay taken between seeds
-    // (a dissolved region frees only the points it took), so a seed skipped early would be
-    // skipped at its exact turn too, and seeds are tried in exactly the order of their
-    // fitted curvatures (ties by index).
+    // queued at its curvature's lower bound; when it comes up with its point and window
+    // still free, its exact curvature is computed (polished from the bounds, or fitted), and
+    // it is tried at once if no other seed comes before that, else queued again at it; the
+    // normal test fits a window only when the bound cannot decide it. Taken points stay
+    // taken between seeds (a dissolved region frees only the points it took), so a seed
+    // skipped early would be skipped at its exact turn too, and seeds are tried in exactly
+    // the order of their exact curvatures (ties by index).
     // Per point: its seed window's plane normal (zero without a complete window, which
     // passes the normal test) and how far it may be from the fitted one (0: fitted).
     // Large clouds share the points among `threads` threads; the seeds are sorted below, so
@@ -1649,11 +1676,15 @@ fn grow_counted(
         }
         let mut acc =
             PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
-        let Some(fit) = acc.fit(&origin) else { continue };
         if unfitted {
             // Its turn comes now unless another seed comes before its exact curvature; then
-            // it waits for its turn (its point and window are checked again then).
-            let exact = Seed::new(fit.curvature(), seed as u32, true);
+            // it waits for its turn (its point and window are checked again then). Most
+            // seeds wait and are taken by others, so the curvature comes without the
+            // eigendecomposition where the bounds allow.
+            let curvature =
+                acc.polished_curvature().or_else(|| acc.fit(&origin).map(|fit| fit.curvature()));
+            let Some(curvature) = curvature else { continue };
+            let exact = Seed::new(curvature, seed as u32, true);
             if seeds.get(next_seed).is_some_and(|s| *s < exact)
                 || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
             {
@@ -1661,6 +1692,7 @@ fn grow_counted(
                 continue;
             }
         }
+        let Some(fit) = acc.fit(&origin) else { continue };
         let mut sum_sigma2: Real =
             window.iter().map(|&(p, _)| tests.sigma[p as usize].powi(2)).sum();
         if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
@@ -1949,6 +1981,35 @@ mod tests {
             ..SegmentConfig::range_camera()
         };
         assert_box_sums_agree(&cloud, &config);
+    }
+
+    /// The curvature floor of windows whose bounds fail is at most the fitted curvature.
+    #[test]
+    fn curvature_floors_are_below_the_fit() {
+        let mut state = 0x6a09_e667_f3bc_c909u64;
+        let mut floors = 0;
+        for k in 0..20_000 {
+            let (noise, stretch) = ([1.0, 0.5, 0.1, 1e-3][k % 4], [1.0, 0.3, 0.01][(k / 4) % 3]);
+            let shift = Vector3::new(random(&mut state), random(&mut state), random(&mut state));
+            let points: Vec<Point3> = (0..3 + k % 30)
+                .map(|_| {
+                    let p = Vector3::new(
+                        random(&mut state),
+                        random(&mut state) * stretch,
+                        random(&mut state) * noise,
+                    );
+                    Point3::from(p + shift * 10.0)
+                })
+                .collect();
+            let acc = PlaneAccumulator::from_points(&points);
+            let (Some(m), Some(fit)) = (acc.scatter(), acc.fit(&Point3::origin())) else {
+                continue;
+            };
+            let floor = curvature_floor(&m).expect("a finite non-zero scatter");
+            assert!(floor <= fit.curvature(), "{k}: {floor} > {}", fit.curvature());
+            floors += usize::from(floor > 0.0);
+        }
+        assert!(floors > 1000, "{floors} positive floors");
     }
 
     /// The radix sort of seeds gives `sort_unstable`'s order, with ties of curvature keys and
