@@ -305,6 +305,39 @@ fn bad_configs_are_errors() {
     assert!(msg.contains("distance_factor"), "{msg}");
 }
 
+/// Grids narrower or lower than a seed window, thin strips, and frames with holes, points at
+/// the sensor and far-off points go through the contiguous-window (box sum) seeds without a panic, and every
+/// point ends up in one region or the remainder.
+#[test]
+fn odd_grids_and_bad_points_segment_without_panics() {
+    let mut state = 7u64;
+    for (w, h) in [(1, 1), (2, 3), (5, 1), (1, 40), (3, 3), (33, 2), (70, 5), (65, 65)] {
+        let pixels: Vec<Option<Point3>> = (0..h)
+            .flat_map(|row| (0..w).map(move |col| (row, col)))
+            .map(|(row, col)| {
+                let u = uniform(&mut state);
+                let p = Point3::new(Real::from(col) * 0.01, Real::from(row) * 0.01, 2.0);
+                match (u * 50.0) as u32 {
+                    0 => None,
+                    1 => Some(Point3::new(0.0, 0.0, 1e-12)),
+                    2 => Some(p + Vector3::new(0.0, 0.0, 1e6)),
+                    _ => Some(p),
+                }
+            })
+            .collect();
+        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+        for config in [SegmentConfig::range_camera(), SegmentConfig::structured_light()] {
+            let config = SegmentConfig { min_region_size: 4, ..config };
+            let seg = segment(&cloud, &config).unwrap();
+            let mut seen: Vec<u32> =
+                seg.regions.iter().flat_map(|r| r.points.iter().copied()).collect();
+            seen.extend(&seg.remainder);
+            seen.sort_unstable();
+            assert_eq!(seen, (0..cloud.len() as u32).collect::<Vec<_>>(), "{w} x {h}");
+        }
+    }
+}
+
 #[test]
 fn empty_clouds_give_empty_segmentations() {
     let config = SegmentConfig::alrf();
