@@ -1370,6 +1370,21 @@ fn seed_of(
     Some((Seed::new(fit.curvature(), i as u32, true), (fit.plane.normal.into_inner(), 0.0)))
 }
 
+/// The lower bound of a window's curvature from its box sums `[n, x, y, z, xx, xy, xz, yy,
+/// yz, zz]` (relative to its tile's point): the certified bound, else [`curvature_floor`];
+/// `None` when the sums are not precise enough ([`BOX_SUM_MAX_SPREAD`]) or the matrix is
+/// not finite.
+fn box_sum_curvature_lower(t: &[Real; 10]) -> Option<Real> {
+    let sum = Vector3::new(t[1], t[2], t[3]);
+    let raw = Matrix3::new(t[4], t[5], t[6], t[5], t[7], t[8], t[6], t[8], t[9]);
+    let scatter = raw - (sum / t[0]) * sum.transpose();
+    let spread = t[4] + t[7] + t[9];
+    if spread.is_nan() || spread > BOX_SUM_MAX_SPREAD * scatter.trace() {
+        return None;
+    }
+    certify(&scatter).map(|bound| bound.curvature_lower).or_else(|| curvature_floor(&scatter))
+}
+
 /// A lower bound of the surface variation `λ₀ / (λ₀ + λ₁ + λ₂)` of a scatter matrix for the
 /// windows whose certified bounds fail (nearly equal smallest eigenvalues: curved or noisy
 /// windows, late in the seed order): `λ₀ = det / (λ₁ λ₂) ≥ 4 det / tr²` since
@@ -1505,19 +1520,8 @@ fn seeds_in_rows(
                                 }
                             }
                             debug_assert_eq!(t[0], full);
-                            let sum = Vector3::new(t[1], t[2], t[3]);
-                            let m = sum / full;
-                            let raw =
-                                Matrix3::new(t[4], t[5], t[6], t[5], t[7], t[8], t[6], t[8], t[9]);
-                            let scatter = raw - m * sum.transpose();
-                            let spread = t[4] + t[7] + t[9];
-                            (spread <= BOX_SUM_MAX_SPREAD * scatter.trace()).then(|| {
-                                certify(&scatter)
-                                    .map(|bound| bound.curvature_lower)
-                                    .or_else(|| curvature_floor(&scatter))
-                            })
+                            box_sum_curvature_lower(&t)
                         })
-                        .flatten()
                         .flatten();
                     match bound {
                         Some(lower) => seeds.push(Seed::new(lower, i as u32, false)),
@@ -1549,6 +1553,20 @@ fn grow(
     threads: NonZeroUsize,
 ) -> Segmentation {
     grow_counted(points, graph, config, up, threads, true).0
+}
+
+/// `f` of each part, in order: the first on this thread, the others on scoped threads of
+/// their own (a panic in `f` propagates).
+fn in_parts<P: Sync, T: Send>(parts: &[P], f: impl Fn(&P) -> T + Sync) -> Vec<T> {
+    std::thread::scope(|s| {
+        let f = &f;
+        let handles: Vec<_> = parts.iter().skip(1).map(|p| s.spawn(move || f(p))).collect();
+        let mut out: Vec<T> = parts.first().map(f).into_iter().collect();
+        out.extend(
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))),
+        );
+        out
+    })
 }
 
 /// The fewest points per thread for which [`grow`] computes seeds on several threads.
@@ -1595,44 +1613,15 @@ fn grow_counted(
         let h = grid.height() as usize;
         let band = h.div_ceil(parts).div_ceil(TILE) * TILE;
         let bands: Vec<_> = (0..h).step_by(band.max(1)).map(|r| r..(r + band).min(h)).collect();
-        let tests = &tests;
-        let seeds = std::thread::scope(|s| {
-            let handles: Vec<_> = bands[1.min(bands.len())..]
-                .iter()
-                .map(|rows| s.spawn(move || seeds_in_rows(rows.clone(), points, graph, tests)))
-                .collect();
-            let mut seeds = bands
-                .first()
-                .map_or_else(Vec::new, |rows| seeds_in_rows(rows.clone(), points, graph, tests));
-            for h in handles {
-                // A worker panics only if `seeds_in_rows` does, which it would here too.
-                seeds.extend(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
-            }
-            seeds
-        });
-        (seeds, Vec::new())
-    } else if parts <= 1 {
-        seeds_in(0..n, points, graph, &tests, with_normals)
+        let seeds = in_parts(&bands, |rows| seeds_in_rows(rows.clone(), points, graph, &tests));
+        (seeds.concat(), Vec::new())
     } else {
         let chunk = n.div_ceil(parts);
-        let tests = &tests;
-        std::thread::scope(|s| {
-            let handles: Vec<_> = (1..parts)
-                .map(|k| {
-                    let range = k * chunk..((k + 1) * chunk).min(n);
-                    s.spawn(move || seeds_in(range, points, graph, tests, with_normals))
-                })
-                .collect();
-            let (mut seeds, mut normals) = seeds_in(0..chunk, points, graph, tests, with_normals);
-            for h in handles {
-                // A worker panics only if `seeds_in` does, which it would here too.
-                let (more, more_normals) =
-                    h.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
-                seeds.extend(more);
-                normals.extend(more_normals);
-            }
-            (seeds, normals)
-        })
+        let ranges: Vec<_> = (0..parts).map(|k| k * chunk..((k + 1) * chunk).min(n)).collect();
+        let found =
+            in_parts(&ranges, |range| seeds_in(range.clone(), points, graph, &tests, with_normals));
+        let (seeds, normals): (Vec<_>, Vec<_>) = found.into_iter().unzip();
+        (seeds.concat(), normals.concat())
     };
     let mut window = Vec::new();
     // Flattest first, ties by index: the keys are distinct (one per point), so an unstable
@@ -1676,14 +1665,20 @@ fn grow_counted(
         }
         let mut acc =
             PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
+        let mut fit_now = None;
         if unfitted {
             // Its turn comes now unless another seed comes before its exact curvature; then
             // it waits for its turn (its point and window are checked again then). Most
             // seeds wait and are taken by others, so the curvature comes without the
             // eigendecomposition where the bounds allow.
-            let curvature =
-                acc.polished_curvature().or_else(|| acc.fit(&origin).map(|fit| fit.curvature()));
-            let Some(curvature) = curvature else { continue };
+            let curvature = match acc.polished_curvature() {
+                Some(c) => c,
+                None => {
+                    let Some(fit) = acc.fit(&origin) else { continue };
+                    fit_now = Some(fit);
+                    fit.curvature()
+                }
+            };
             let exact = Seed::new(curvature, seed as u32, true);
             if seeds.get(next_seed).is_some_and(|s| *s < exact)
                 || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
@@ -1692,7 +1687,7 @@ fn grow_counted(
                 continue;
             }
         }
-        let Some(fit) = acc.fit(&origin) else { continue };
+        let Some(fit) = fit_now.or_else(|| acc.fit(&origin)) else { continue };
         let mut sum_sigma2: Real =
             window.iter().map(|&(p, _)| tests.sigma[p as usize].powi(2)).sum();
         if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
