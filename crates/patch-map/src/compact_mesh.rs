@@ -12,7 +12,10 @@
 //! Leaves test each triangle's own `f64` box (computed from its vertices) before the exact
 //! test, so pruning is as tight as with one triangle per leaf. The tree is built top-down by
 //! the surface area heuristic over binned centroids; below depth [`SAH_DEPTH`] it splits at the
-//! median, so every tree is at most about 70 levels deep and the walks need no heap.
+//! median, so every tree is at most about 70 levels deep and the walks need no heap. The splits
+//! see each triangle's box on a 16-bit grid over the mesh's box (12 bytes per triangle while
+//! building); the nodes' boxes are then computed bottom-up from the vertices, so they are as
+//! tight as the `f32` rounding allows.
 //!
 //! The mesh is also a parry [`Shape`] (of type [`ShapeType::Custom`]): the rapier map's
 //! colliders hold it, so both maps store triangles the same compact way and answer through
@@ -78,17 +81,69 @@ pub(crate) struct CompactMesh {
     nodes: Vec<Node>,
 }
 
-/// A triangle's box (rounded outwards) during the build.
+/// A triangle's box during the build, in [`Items::STEPS`] steps across the mesh's box along
+/// each axis: it only steers the splits (the nodes' boxes are computed from the vertices once
+/// the tree stands), so 12 bytes per triangle suffice.
 #[derive(Clone, Copy)]
 struct Item {
-    min: [f32; 3],
-    max: [f32; 3],
+    min: [u16; 3],
+    max: [u16; 3],
 }
 
-impl Item {
-    /// The centre of the box along `axis` (the triangle's "centroid" for binning).
-    fn centroid(&self, axis: usize) -> Real {
-        0.5 * (Real::from(self.min[axis]) + Real::from(self.max[axis]))
+/// The triangles' [`Item`]s and the grid they are measured on.
+struct Items {
+    items: Vec<Item>,
+    origin: [Real; 3],
+    /// Metres per step along each axis (0 for an axis the mesh is flat in).
+    step: [Real; 3],
+}
+
+impl Items {
+    /// Steps across the mesh's box.
+    const STEPS: Real = u16::MAX as Real;
+
+    /// The items of `indices` into `vertices` (a mesh of at least one triangle).
+    fn new(vertices: &[Point3], indices: &[[u32; 3]]) -> Items {
+        let mut bounds = Bounds::EMPTY;
+        for p in vertices {
+            bounds.add_point(&[p.x, p.y, p.z]);
+        }
+        let origin = bounds.min;
+        let extent = [0, 1, 2].map(|k| bounds.max[k] - bounds.min[k]);
+        let step = extent.map(|e| if e > 0.0 { e / Self::STEPS } else { 0.0 });
+        let scale = step.map(|s| if s > 0.0 { 1.0 / s } else { 0.0 });
+        // Rounded outwards and clamped; `as` saturates, so rounding error cannot wrap.
+        let at = |x: Real, k: usize| (x - origin[k]) * scale[k];
+        let items = indices
+            .iter()
+            .map(|t| {
+                let mut b = Bounds::EMPTY;
+                for &i in t {
+                    let p = &vertices[i as usize];
+                    b.add_point(&[p.x, p.y, p.z]);
+                }
+                Item {
+                    min: [0, 1, 2].map(|k| at(b.min[k], k).floor() as u16),
+                    max: [0, 1, 2].map(|k| at(b.max[k], k).ceil() as u16),
+                }
+            })
+            .collect();
+        Items { items, origin, step }
+    }
+
+    /// The centre of triangle `i`'s box along `axis` (its "centroid" for binning), metres.
+    fn centroid(&self, i: u32, axis: usize) -> Real {
+        let item = &self.items[i as usize];
+        let steps = 0.5 * (Real::from(item.min[axis]) + Real::from(item.max[axis]));
+        self.origin[axis] + steps * self.step[axis]
+    }
+
+    /// Grows `bounds` by triangle `i`'s box.
+    fn add_to(&self, bounds: &mut Bounds, i: u32) {
+        let item = &self.items[i as usize];
+        let at = |s: [u16; 3]| [0, 1, 2].map(|k| self.origin[k] + Real::from(s[k]) * self.step[k]);
+        bounds.add_point(&at(item.min));
+        bounds.add_point(&at(item.max));
     }
 }
 
@@ -131,10 +186,6 @@ impl Bounds {
         self.add_point(&b.max);
     }
 
-    fn add_item(&mut self, item: &Item) {
-        self.add_box(&item.min, &item.max);
-    }
-
     /// Half the surface area (the heuristic's measure); 0 when empty.
     fn half_area(&self) -> Real {
         let d = [0, 1, 2].map(|k| (self.max[k] - self.min[k]).max(0.0));
@@ -155,29 +206,14 @@ impl CompactMesh {
         if indices.is_empty() {
             return None;
         }
-        let items: Vec<Item> = indices
-            .iter()
-            .map(|t| {
-                let mut b = Bounds::EMPTY;
-                for &i in t {
-                    let p = &vertices[i as usize];
-                    b.add_point(&[p.x, p.y, p.z]);
-                }
-                Item { min: b.min.map(down), max: b.max.map(up) }
-            })
-            .collect();
+        let items = Items::new(&vertices, &indices);
         let mut order: Vec<u32> = (0..indices.len() as u32).collect();
         let mut nodes = Vec::with_capacity(2 * indices.len().div_ceil(LEAF_SIZE));
         nodes.push(Node { min: [0.0; 3], max: [0.0; 3], first: 0, count: 0 });
+        // The tree's shape, top-down (its boxes come last, from the vertices).
         // (node, range of `order`, depth)
         let mut work = vec![(0usize, 0usize, indices.len(), 0usize)];
         while let Some((node, start, end, depth)) = work.pop() {
-            let mut bounds = Bounds::EMPTY;
-            for &i in &order[start..end] {
-                bounds.add_item(&items[i as usize]);
-            }
-            nodes[node].min = bounds.min.map(down);
-            nodes[node].max = bounds.max.map(up);
             let count = end - start;
             if count <= LEAF_SIZE {
                 nodes[node].first = start as u32;
@@ -231,6 +267,27 @@ impl CompactMesh {
         drop(new_index);
         vertices.truncate(used as usize);
         vertices.shrink_to_fit();
+        // The boxes bottom-up (children come after their parent): a leaf's from its
+        // triangles' vertices, an inner node's around its children's, rounded outwards.
+        for n in (0..nodes.len()).rev() {
+            let Node { first, count, .. } = nodes[n];
+            let (first, count) = (first as usize, count as usize);
+            let mut bounds = Bounds::EMPTY;
+            if count > 0 {
+                for t in &indices[first..first + count] {
+                    for &v in t {
+                        let p = &vertices[v as usize];
+                        bounds.add_point(&[p.x, p.y, p.z]);
+                    }
+                }
+            } else {
+                for child in &nodes[first..first + 2] {
+                    bounds.add_box(&child.min, &child.max);
+                }
+            }
+            nodes[n].min = bounds.min.map(down);
+            nodes[n].max = bounds.max.map(up);
+        }
         Some((CompactMesh { vertices, indices, nodes }, tags))
     }
 
@@ -310,18 +367,17 @@ fn permute_in_place<T: Copy>(data: &mut [T], order: &mut [u32]) {
 /// (never 0 or all): the best of [`BINS`] centroid bins along the longest centroid axis by the
 /// surface area heuristic, or the median below depth [`SAH_DEPTH`] and where the heuristic
 /// finds no split.
-fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
+fn split(items: &Items, order: &mut [u32], depth: usize) -> usize {
     let mut cb = Bounds::EMPTY;
     for &i in order.iter() {
-        let item = &items[i as usize];
-        cb.add_point(&[0, 1, 2].map(|k| item.centroid(k)));
+        cb.add_point(&[0, 1, 2].map(|k| items.centroid(i, k)));
     }
     let extent = [0, 1, 2].map(|k| cb.max[k] - cb.min[k]);
     let axis = (0..3).fold(0, |a, k| if extent[k] > extent[a] { k } else { a });
     let median = |order: &mut [u32]| {
         let mid = order.len() / 2;
         order.select_nth_unstable_by(mid, |&x, &y| {
-            items[x as usize].centroid(axis).total_cmp(&items[y as usize].centroid(axis))
+            items.centroid(x, axis).total_cmp(&items.centroid(y, axis))
         });
         mid
     };
@@ -331,14 +387,14 @@ fn split(items: &[Item], order: &mut [u32], depth: usize) -> usize {
     }
     let scale = BINS as Real / extent[axis];
     let bin = |i: u32| {
-        let b = ((items[i as usize].centroid(axis) - cb.min[axis]) * scale) as usize;
+        let b = ((items.centroid(i, axis) - cb.min[axis]) * scale) as usize;
         b.min(BINS - 1)
     };
     let mut boxes = [Bounds::EMPTY; BINS];
     let mut counts = [0usize; BINS];
     for &i in order.iter() {
         let b = bin(i);
-        boxes[b].add_item(&items[i as usize]);
+        items.add_to(&mut boxes[b], i);
         counts[b] += 1;
     }
     // Cost of splitting after bin `k`: area × count on each side.
@@ -597,11 +653,56 @@ mod tests {
         })
     }
 
+    /// The box of the triangles under `node`, rounded outwards to `f32`.
+    fn tight_box(mesh: &CompactMesh, node: u32) -> ([f32; 3], [f32; 3]) {
+        let n = &mesh.nodes[node as usize];
+        let mut b = Bounds::EMPTY;
+        if n.count > 0 {
+            for i in n.first..n.first + n.count {
+                let t = mesh.triangle_aabb(i);
+                b.add_point(&[t.mins.x, t.mins.y, t.mins.z]);
+                b.add_point(&[t.maxs.x, t.maxs.y, t.maxs.z]);
+            }
+            (b.min.map(down), b.max.map(up))
+        } else {
+            let (l, r) = (tight_box(mesh, n.first), tight_box(mesh, n.first + 1));
+            (
+                std::array::from_fn(|k| l.0[k].min(r.0[k])),
+                std::array::from_fn(|k| l.1[k].max(r.1[k])),
+            )
+        }
+    }
+
+    /// Every node's box is the tightest `f32` box of its triangles.
+    fn assert_tight(mesh: &CompactMesh) {
+        for node in 0..mesh.nodes.len() as u32 {
+            let n = &mesh.nodes[node as usize];
+            assert_eq!((n.min, n.max), tight_box(mesh, node), "node {node}");
+        }
+    }
+
+    #[test]
+    fn a_flat_grid_makes_tight_boxes() {
+        // 2 × 40 × 40 triangles in the plane z = 1.5: the build's grid has no extent in z.
+        let tris: Vec<[Real; 9]> = (0..40 * 40)
+            .flat_map(|k| {
+                let (x, y) = (Real::from(k % 40) * 0.1, Real::from(k / 40) * 0.1);
+                [
+                    [x, y, 1.5, x + 0.1, y, 1.5, x, y + 0.1, 1.5],
+                    [x + 0.1, y, 1.5, x + 0.1, y + 0.1, 1.5, x, y + 0.1, 1.5],
+                ]
+            })
+            .collect();
+        assert_tight(&mesh(&tris));
+    }
+
     proptest! {
-        /// Every node's box holds the boxes below it, and every triangle is in one leaf.
+        /// Every node's box holds the boxes below it and is the tightest `f32` box of its
+        /// triangles, and every triangle is in one leaf.
         #[test]
         fn boxes_hold_their_triangles(tris in triangles()) {
             let mesh = mesh(&tris);
+            assert_tight(&mesh);
             let mut seen = vec![0; tris.len()];
             let mut stack = vec![(0u32, None::<BoxAabb>)];
             while let Some((id, parent)) = stack.pop() {

@@ -219,7 +219,8 @@ pub fn patch_mesh(patches: &[Patch]) -> Result<(Vec<Point3>, Vec<[u32; 3]>)> {
 /// Extracts the planes, hybrid and trimesh maps' patches from the scans `clouds` (of
 /// [`scan_lab`]), loads each into every patch backend (keeping the planning backend's), builds
 /// the pc map, and writes each map's 3D file (`map-KIND.ply`). The scans are dropped once the
-/// pc map's points are taken from them, before its map is built (the demo's memory peak).
+/// last kind's patches and the pc map's points are taken from them, before that kind's maps
+/// are built (the demo's memory peak).
 pub fn build_maps(
     clouds: Vec<PointCloud>,
     progress: &dyn Progress,
@@ -229,12 +230,23 @@ pub fn build_maps(
     let bar =
         progress.bar((kinds.len() * (Backend::patch_backends().count() + 1) + 1) as u64, "maps");
     let mut built = Built { maps: Vec::new(), rows: Vec::new(), drawings: Vec::new() };
+    // The scans until their last use (the last kind's extraction), then the pc map's points
+    // taken from them (and the seconds that took).
+    let mut clouds = Some(clouds);
+    let mut pc = None;
     for kind in kinds {
         let t0 = Instant::now();
-        let patches = extracted_patches(&clouds, kind)
+        let scans = clouds.as_ref().context("the scans are kept until the last extraction")?;
+        let patches = extracted_patches(scans, kind)
             .with_context(|| format!("extracting the {kind} map"))?
             .context("a patch map has patches")?;
         let extraction = t0.elapsed().as_secs_f64();
+        if Some(&kind) == kinds.last() {
+            let t0 = Instant::now();
+            let points: Vec<Point3> = crate::scene_map::pc_points(scans, &Default::default())?;
+            pc = Some((points, scans.len(), t0.elapsed().as_secs_f64()));
+            clouds = None;
+        }
         bar.inc(1);
         let (planar, trimesh, triangles) = patch_counts(&patches)?;
         built.drawings.push(drawing(kind, &patches));
@@ -283,12 +295,10 @@ pub fn build_maps(
         rows.sort_by_key(|(backend, _)| Backend::ALL.iter().position(|b| b == backend));
         built.rows.extend(rows.into_iter().map(|(_, row)| row));
     }
+    let (points, scans, gather_seconds) = pc.context("the pc points are taken")?;
     let t0 = Instant::now();
-    let points: Vec<Point3> = crate::scene_map::pc_points(&clouds, &Default::default())?;
-    let scans = clouds.len();
-    drop(clouds);
     let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
-    let build_seconds = t0.elapsed().as_secs_f64();
+    let build_seconds = gather_seconds + t0.elapsed().as_secs_f64();
     let (row, drawing) = point_map_entry(&map, &points, build_seconds)?;
     built.rows.push(row);
     built.drawings.push(drawing);
