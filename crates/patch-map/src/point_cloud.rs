@@ -110,11 +110,33 @@ impl PointCloudMap {
         Ok(map)
     }
 
-    /// Adds points (all or none: a non-finite point refuses the whole batch).
-    ///
-    /// # Complexity
-    /// Amortised `O(m log² n)` for `m` points.
-    pub fn add_points(&mut self, points: &[Point3]) -> Result<(), PointCloudMapError> {
+    /// A map of `points`, which must be finite: the same map as
+    /// [`from_points`](Self::from_points), built from the vector's end. Each level takes its
+    /// points off the end and the vector is shrunk, so the points are held about once while
+    /// the map is built, not twice.
+    pub fn from_point_vec(mut points: Vec<Point3>) -> Result<PointCloudMap, PointCloudMapError> {
+        let mut map = PointCloudMap::new();
+        map.admit(&points)?;
+        let len = points.len();
+        map.levels.resize_with((usize::BITS - len.leading_zeros()) as usize, || None);
+        for level in (0..map.levels.len()).rev() {
+            let size = 1usize << level;
+            if len & size != 0 {
+                let start = points.len() - size;
+                let tail: Vec<[Real; 3]> =
+                    points[start..].iter().map(|p| [p.x, p.y, p.z]).collect();
+                points.truncate(start);
+                points.shrink_to_fit();
+                map.levels[level] = Some(Level::build(tail));
+            }
+        }
+        map.len = len;
+        Ok(map)
+    }
+
+    /// Checks that `points` may join the map (all finite, not too many) and grows the bounds
+    /// by them.
+    fn admit(&mut self, points: &[Point3]) -> Result<(), PointCloudMapError> {
         if let Some(index) = points.iter().position(|p| !p.coords.iter().all(|v| v.is_finite())) {
             return Err(PointCloudMapError::NonFinite { index });
         }
@@ -124,6 +146,15 @@ impl PointCloudMap {
         for p in points {
             self.bounds.grow(p);
         }
+        Ok(())
+    }
+
+    /// Adds points (all or none: a non-finite point refuses the whole batch).
+    ///
+    /// # Complexity
+    /// Amortised `O(m log² n)` for `m` points.
+    pub fn add_points(&mut self, points: &[Point3]) -> Result<(), PointCloudMapError> {
+        self.admit(points)?;
         // Binary-counter merge, one level per set bit of the new length: the new points and
         // every level whose bit carries are rebuilt into the level where the carry stops. The
         // points flow from the input and the old levels straight into the new levels (each
@@ -286,6 +317,22 @@ mod tests {
                 // Conservative only within the grazing tolerance.
                 prop_assert!(d <= r + 1e-6, "reported colliding, but the nearest point is {d} > {r}");
             }
+        }
+
+        /// Built from a vector, the map has the same levels, holding the same points in the
+        /// same order, as built from a slice.
+        #[test]
+        fn from_point_vec_builds_the_same_map(pts in prop::collection::vec(point(), 0..300), q in point()) {
+            let a = PointCloudMap::from_points(&pts).unwrap();
+            let b = PointCloudMap::from_point_vec(pts.clone()).unwrap();
+            prop_assert_eq!(a.len(), b.len());
+            prop_assert_eq!(a.bounds(), b.bounds());
+            let level_sizes = |m: &PointCloudMap| {
+                m.levels.iter().map(|l| l.as_ref().map(|l| l.points.len())).collect::<Vec<_>>()
+            };
+            prop_assert_eq!(level_sizes(&a), level_sizes(&b));
+            prop_assert!(a.points().eq(b.points()));
+            prop_assert_eq!(a.nearest(&q), b.nearest(&q));
         }
 
         #[test]

@@ -303,6 +303,11 @@ impl PointCloud {
         &self.positions
     }
 
+    /// The point positions, dropping every other attribute.
+    pub fn into_positions(self) -> Vec<Point3> {
+        self.positions
+    }
+
     /// Per-point intensity, reflectance or amplitude, if known.
     pub fn intensity(&self) -> Option<&[f32]> {
         self.intensity.as_deref()

@@ -10,12 +10,14 @@ use crate::results::{MapDrawing, MapRow, P3};
 use crate::scene_map::{
     BuiltMap, MapKind, ScanSetup, extracted_patches, patch_map, planar_triangles, scan_clouds,
 };
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use patch_core::triangulate::patch_triangles;
 use patch_core::{Patch, Point3};
 use patch_map::{AnyMap, Backend, PointCloudMap};
 use pointcloud::PointCloud;
 use scene_sim::Scene;
+use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::Path;
 use std::time::Instant;
 
 /// The backend each patch map type is planned on: the parry BVH (the role of the thesis's
@@ -244,7 +246,8 @@ pub fn build_maps(
         if Some(&kind) == kinds.last() {
             let t0 = Instant::now();
             let points: Vec<Point3> = crate::scene_map::pc_points(scans, &Default::default())?;
-            pc = Some((points, scans.len(), t0.elapsed().as_secs_f64()));
+            let parked = ParkedPoints::park(points, &files.path(""))?;
+            pc = Some((parked, scans.len(), t0.elapsed().as_secs_f64()));
             clouds = None;
         }
         bar.inc(1);
@@ -295,17 +298,18 @@ pub fn build_maps(
         rows.sort_by_key(|(backend, _)| Backend::ALL.iter().position(|b| b == backend));
         built.rows.extend(rows.into_iter().map(|(_, row)| row));
     }
-    let (points, scans, gather_seconds) = pc.context("the pc points are taken")?;
+    let (parked, scans, gather_seconds) = pc.context("the pc points are taken")?;
+    let cloud = PointCloud::from_positions(parked.take()?)?;
+    let name = "map-pc.ply";
+    write_ply_f32(&files.path(name), &cloud)?;
+    files.add("pc map: the scans' points in the world frame", name)?;
+    let points_len = cloud.len();
     let t0 = Instant::now();
-    let map = AnyMap::PointCloud(PointCloudMap::from_points(&points)?);
+    let map = AnyMap::PointCloud(PointCloudMap::from_point_vec(cloud.into_positions())?);
     let build_seconds = gather_seconds + t0.elapsed().as_secs_f64();
-    let (row, drawing) = point_map_entry(&map, &points, build_seconds)?;
+    let (row, drawing) = point_map_entry(&map, build_seconds)?;
     built.rows.push(row);
     built.drawings.push(drawing);
-    let name = "map-pc.ply";
-    let points_len = points.len();
-    write_ply_f32(&files.path(name), &PointCloud::from_positions(points)?)?;
-    files.add("pc map: the scans' points in the world frame", name)?;
     built.maps.push(BuiltMap {
         kind: MapKind::Pc,
         map,
@@ -320,28 +324,106 @@ pub fn build_maps(
     Ok(built)
 }
 
-/// The Table 6.1 row and the drawing of a point-cloud (`pc`) map holding `points`, built in
-/// `build_seconds` — shared by the demo and `patchnav run`.
-pub fn point_map_entry(
-    map: &AnyMap,
-    points: &[Point3],
-    build_seconds: f64,
-) -> Result<(MapRow, MapDrawing)> {
+/// The Table 6.1 row and the drawing (at most [`MAX_DRAWN`] of its points) of a point-cloud
+/// (`pc`) map built in `build_seconds` — shared by the demo and `patchnav run`.
+///
+/// # Errors
+/// `map` not a point-cloud map.
+pub fn point_map_entry(map: &AnyMap, build_seconds: f64) -> Result<(MapRow, MapDrawing)> {
+    let AnyMap::PointCloud(pc) = map else {
+        bail!("a `{}` map is not a point-cloud map", map.backend())
+    };
     let row = MapRow {
         kind: MapKind::Pc.name().to_owned(),
         backend: map.backend().to_string(),
         planar_patches: 0,
         trimesh_patches: 0,
         triangles: 0,
-        points: points.len(),
+        points: pc.len(),
         memory_bytes: map.memory_bytes(),
         file_bytes: map.save(std::io::sink())?,
         build_seconds,
     };
+    let stride = pc.len().div_ceil(MAX_DRAWN).max(1);
     let drawing = MapDrawing {
         kind: MapKind::Pc.name().to_owned(),
-        points: decimate(points, MAX_DRAWN).iter().map(p3mm).collect(),
+        points: pc.points().step_by(stride).map(|p| p3mm(&p)).collect(),
         ..MapDrawing::default()
     };
     Ok((row, drawing))
+}
+
+/// Points waiting in an unnamed temporary file (exact `f64`s, removed when closed), so they
+/// take no memory meanwhile: the demo parks the pc map's points while the trimesh map, its
+/// memory peak, is built.
+struct ParkedPoints {
+    file: std::fs::File,
+    len: usize,
+}
+
+impl ParkedPoints {
+    /// Writes `points` to a temporary file in `dir` and frees them.
+    fn park(points: Vec<Point3>, dir: &Path) -> Result<ParkedPoints> {
+        let context = || format!("parking the pc points in a temporary file in {}", dir.display());
+        let file = tempfile::tempfile_in(dir).with_context(context)?;
+        let mut w = BufWriter::new(file);
+        for p in &points {
+            for c in [p.x, p.y, p.z] {
+                w.write_all(&c.to_le_bytes()).with_context(context)?;
+            }
+        }
+        let file = w.into_inner().map_err(|e| e.into_error()).with_context(context)?;
+        Ok(ParkedPoints { file, len: points.len() })
+    }
+
+    /// The points, read back.
+    fn take(self) -> Result<Vec<Point3>> {
+        let context = || "reading the parked pc points back";
+        let mut file = self.file;
+        file.seek(SeekFrom::Start(0)).with_context(context)?;
+        let mut r = BufReader::new(file);
+        let mut points = Vec::with_capacity(self.len);
+        let mut buf = [0u8; 24];
+        for _ in 0..self.len {
+            r.read_exact(&mut buf).with_context(context)?;
+            let c =
+                |k: usize| f64::from_le_bytes(buf[8 * k..8 * k + 8].try_into().expect("8 bytes"));
+            points.push(Point3::new(c(0), c(1), c(2)));
+        }
+        Ok(points)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parked_points_come_back_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let points = vec![
+            Point3::new(0.1, -0.0, 1e-310),
+            Point3::new(f64::MAX, f64::MIN_POSITIVE, -123_456.789_012_345),
+            Point3::new(1.0 / 3.0, 2.0_f64.sqrt(), -1e300),
+        ];
+        let parked = ParkedPoints::park(points.clone(), dir.path()).unwrap();
+        // The file is unnamed: nothing is left in the folder.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        let back = parked.take().unwrap();
+        assert_eq!(back.len(), points.len());
+        for (a, b) in back.iter().zip(&points) {
+            for k in 0..3 {
+                assert_eq!(a[k].to_bits(), b[k].to_bits());
+            }
+        }
+        assert!(ParkedPoints::park(Vec::new(), dir.path()).unwrap().take().unwrap().is_empty());
+    }
+
+    #[test]
+    fn parking_in_a_missing_folder_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("missing");
+        let err = ParkedPoints::park(vec![Point3::origin()], &missing).err().unwrap();
+        assert!(format!("{err:#}").contains("parking the pc points"), "{err:#}");
+    }
 }

@@ -212,15 +212,15 @@ impl Maps {
             let AnyMap::PointCloud(pc) = &map else {
                 bail!("a `{}` map has neither patches nor points", map.backend())
             };
-            let points: Vec<Point3> = pc.points().collect();
-            if points.is_empty() {
+            if pc.is_empty() {
                 bail!("the pc map has no points");
             }
-            let (row, drawing) = point_map_entry(&map, &points, seconds)?;
+            let (row, drawing) = point_map_entry(&map, seconds)?;
             self.rows.push(row);
             self.drawings.push(drawing);
             if write_3d {
                 let name = "map-pc.ply";
+                let points: Vec<Point3> = pc.points().collect();
                 write_ply_f32(&files.path(name), &PointCloud::from_positions(points)?)?;
                 files.add("pc map: its points in the world frame", name)?;
             }
