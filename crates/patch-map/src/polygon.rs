@@ -275,7 +275,12 @@ impl<S: Step> UnspecificStepIntersector<S> for PolygonMap {
     /// Any-hit loop: stops at the first patch the step touches.
     fn is_step_free(&self, step: &S) -> bool {
         let query = slackened(step.bounds());
-        !self.entries().any(|(_, patch, b)| b.intersects(&query) && patch.collides_with(step))
+        // No ids needed: the boxes and patches side by side, the box test inlined.
+        !self
+            .boxes
+            .iter()
+            .zip(&self.patches)
+            .any(|(b, patch)| b.intersects(&query) && patch.collides_with(step))
     }
 }
 
