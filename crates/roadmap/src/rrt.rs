@@ -143,6 +143,7 @@ pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector + ?Sized>(
 ) -> PlannerStatus {
     let started = Instant::now();
     solution.reset(&problem.goals);
+    solution.reserve_for(stop.iteration_budget());
     let mut checker = Checker::new(map, space.robot_radius());
     if let Some(invalid) = planner::validate(problem, space, &mut checker) {
         solution.finish(0, &checker);
