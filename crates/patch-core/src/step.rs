@@ -53,6 +53,7 @@ pub trait Step: Copy + Debug {
     }
 }
 
+#[inline]
 fn check_point(p: &Point3, which: &'static str) -> Result<(), StepError> {
     if p.iter().all(|c| c.is_finite()) { Ok(()) } else { Err(StepError::NonFinitePoint { which }) }
 }
@@ -158,6 +159,7 @@ impl CapsuleStep {
     /// # Errors
     /// [`StepError::NonFinitePoint`] for a NaN or infinite coordinate,
     /// [`StepError::InvalidRadius`] for a negative, NaN or infinite radius.
+    #[inline]
     pub fn new(start: Point3, end: Point3, radius: Real) -> Result<CapsuleStep, StepError> {
         check_point(&start, "start")?;
         check_point(&end, "end")?;

@@ -152,13 +152,27 @@ impl Nearest {
 /// * [`closest_patch`](ProximityQuery::closest_patch): O(P) box distances plus O(n) per patch
 ///   whose box is nearer than the best distance so far (and than `max_dist`).
 ///
-/// Memory: the patches and one [`Aabb`] (48 bytes) per patch.
+/// The any-hit loop ([`is_step_free`](UnspecificStepIntersector::is_step_free)) visits the
+/// patches largest box first (by the sum of the box's edge lengths, then by id): a large
+/// patch (a floor, a long wall) is the likeliest to stop a colliding step early. The answer
+/// does not depend on the order.
+///
+/// Memory: the patches, one [`Aabb`] (48 bytes) per patch, and a copy of it with the patch's
+/// id in visiting order (56 bytes).
 #[derive(Clone, Debug)]
 pub struct PolygonMap {
     patches: Vec<Patch>,
     /// `boxes[i] = patches[i].bounds()`.
     boxes: Vec<Aabb>,
+    /// `(boxes[i], i)` for every patch, in the any-hit loop's order (see [`visit_before`]).
+    visit: Vec<(Aabb, u32)>,
     bounds: Aabb,
+}
+
+/// The any-hit loop's order: larger boxes (sum of edge lengths) first, then lower ids.
+fn visit_before(a: &(Aabb, u32), b: &(Aabb, u32)) -> std::cmp::Ordering {
+    let size = |b: &Aabb| b.extents().sum();
+    size(&b.0).total_cmp(&size(&a.0)).then(a.1.cmp(&b.1))
 }
 
 impl Default for PolygonMap {
@@ -170,7 +184,12 @@ impl Default for PolygonMap {
 impl PolygonMap {
     /// The empty map.
     pub fn new() -> PolygonMap {
-        PolygonMap { patches: Vec::new(), boxes: Vec::new(), bounds: Aabb::EMPTY }
+        PolygonMap {
+            patches: Vec::new(),
+            boxes: Vec::new(),
+            visit: Vec::new(),
+            bounds: Aabb::EMPTY,
+        }
     }
 
     /// The empty map with room for `capacity` patches.
@@ -178,8 +197,19 @@ impl PolygonMap {
         PolygonMap {
             patches: Vec::with_capacity(capacity),
             boxes: Vec::with_capacity(capacity),
+            visit: Vec::with_capacity(capacity),
             bounds: Aabb::EMPTY,
         }
+    }
+
+    /// Appends the patch and its box (not to the visiting order).
+    fn push(&mut self, patch: Patch) -> Result<PatchId, MapError> {
+        let id = next_id(self.patches.len())?;
+        let b = patch.bounds();
+        self.bounds = self.bounds.union(&b);
+        self.patches.push(patch);
+        self.boxes.push(b);
+        Ok(id)
     }
 
     /// Gives the patches back, in id order.
@@ -206,6 +236,7 @@ impl PolygonMap {
     pub(crate) fn heap_bytes(&self) -> usize {
         crate::persist::patches_memory_bytes(&self.patches)
             + self.boxes.capacity() * std::mem::size_of::<Aabb>()
+            + self.visit.capacity() * std::mem::size_of::<(Aabb, u32)>()
     }
 }
 
@@ -228,11 +259,10 @@ impl PatchMapMut for PolygonMap {
     /// Appends the patch: O(n) for its box, O(1) amortised otherwise. Never refuses a patch
     /// kind.
     fn add_patch(&mut self, patch: Patch) -> Result<PatchId, MapError> {
-        let id = next_id(self.patches.len())?;
-        let b = patch.bounds();
-        self.bounds = self.bounds.union(&b);
-        self.patches.push(patch);
-        self.boxes.push(b);
+        let id = self.push(patch)?;
+        let entry = (self.boxes[id.0 as usize], id.0);
+        let at = self.visit.partition_point(|e| visit_before(e, &entry).is_lt());
+        self.visit.insert(at, entry);
         Ok(id)
     }
 }
@@ -245,8 +275,11 @@ impl FromPatches for PolygonMap {
         let patches = patches.into_iter();
         let mut map = PolygonMap::with_capacity(patches.size_hint().0);
         for patch in patches {
-            map.add_patch(patch)?;
+            map.push(patch)?;
         }
+        // One sort instead of an insertion per patch. Ids fit in u32 (checked by `push`).
+        map.visit = map.boxes.iter().enumerate().map(|(i, b)| (*b, i as u32)).collect();
+        map.visit.sort_unstable_by(visit_before);
         Ok(map)
     }
 }
@@ -275,7 +308,10 @@ impl<S: Step> UnspecificStepIntersector<S> for PolygonMap {
     /// Any-hit loop: stops at the first patch the step touches.
     fn is_step_free(&self, step: &S) -> bool {
         let query = slackened(step.bounds());
-        !self.entries().any(|(_, patch, b)| b.intersects(&query) && patch.collides_with(step))
+        !self
+            .visit
+            .iter()
+            .any(|(b, i)| b.intersects(&query) && self.patches[*i as usize].collides_with(step))
     }
 }
 
@@ -360,6 +396,45 @@ mod tests {
         assert!(map.closest_patch(&Point3::new(Real::NAN, 0.0, 0.0), 1.0).is_none());
         let far = Point3::new(0.5, 0.5, 2.75);
         assert_eq!(map.closest_patch(&far, Real::INFINITY).unwrap().patch, PatchId(2));
+    }
+
+    #[test]
+    fn many_patches_answer_like_the_reference_and_are_visited_largest_first() {
+        // 150 floor tiles of three sizes (exact in binary, so sizes tie exactly) in a 15 × 10
+        // grid at four heights; every step is
+        // tested against the reference.
+        let tiles: Vec<Patch> = (0..150)
+            .map(|i| {
+                let (x, y) = (Real::from(i % 15), Real::from(i / 15));
+                let size = [0.25, 0.75, 0.5][i as usize % 3];
+                let pose = Isometry3::translation(0.0, 0.0, Real::from(i % 4) * 0.5);
+                PlanarPatch::rectangle(pose, Point2::new(x, y), Point2::new(x + size, y + size))
+                    .unwrap()
+                    .into()
+            })
+            .collect();
+        let map = PolygonMap::from_patches(tiles.clone()).unwrap();
+        let reference = BruteForceMap::from_patches(tiles.clone()).unwrap();
+        let mut hits = 0;
+        for i in 0..400 {
+            let t = Real::from(i);
+            let a = Point3::new((t * 0.37) % 15.0, (t * 0.53) % 10.0, 1.2 + (t * 0.11) % 0.5);
+            let b = Point3::new((t * 0.71) % 15.0, (t * 0.29) % 10.0, -0.3 + (t * 0.13) % 1.0);
+            let step = CapsuleStep::new(a, b, 0.05 + (t * 0.07) % 0.2).unwrap();
+            let free = reference.is_step_free(&step);
+            assert_eq!(map.is_step_free(&step), free, "step {i}");
+            hits += usize::from(!free);
+        }
+        assert!(hits > 50 && hits < 350, "{hits} hits");
+        // Largest first, ties by id; adding one by one gives the order of `from_patches`.
+        assert!(map.visit.windows(2).all(|w| visit_before(&w[0], &w[1]).is_lt()));
+        assert_eq!(map.visit.len(), 150);
+        assert_eq!((map.visit[0].1, map.visit[149].1), (1, 147));
+        let mut grown = PolygonMap::new();
+        for tile in tiles {
+            grown.add_patch(tile).unwrap();
+        }
+        assert_eq!(grown.visit, map.visit);
     }
 
     #[test]

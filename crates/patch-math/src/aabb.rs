@@ -24,6 +24,7 @@ impl Aabb {
 
     /// The box with the given corners. The corners are sorted per axis, so any two opposite
     /// corners work.
+    #[inline]
     pub fn new(a: Point3, b: Point3) -> Aabb {
         Aabb { min: a.inf(&b), max: a.sup(&b) }
     }
@@ -38,43 +39,58 @@ impl Aabb {
     }
 
     /// Whether the box holds no point at all.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
     }
 
     /// Grows the box to hold `p`.
+    #[inline]
     pub fn grow(&mut self, p: &Point3) {
         self.min = self.min.inf(p);
         self.max = self.max.sup(p);
     }
 
     /// The smallest box holding both boxes.
+    #[inline]
     pub fn union(&self, other: &Aabb) -> Aabb {
         Aabb { min: self.min.inf(&other.min), max: self.max.sup(&other.max) }
     }
 
     /// The box grown by `margin` on every side (shrunk for a negative margin).
+    #[inline]
     pub fn inflated(&self, margin: Real) -> Aabb {
         let m = Vector3::repeat(margin);
         Aabb { min: self.min - m, max: self.max + m }
     }
 
     /// Whether `p` lies in the closed box.
+    #[inline]
     pub fn contains(&self, p: &Point3) -> bool {
         (0..3).all(|i| self.min[i] <= p[i] && p[i] <= self.max[i])
     }
 
     /// Whether the two closed boxes share at least one point.
+    #[inline]
     pub fn intersects(&self, other: &Aabb) -> bool {
-        (0..3).all(|i| self.min[i] <= other.max[i] && other.min[i] <= self.max[i])
+        // Without short-circuits: six comparisons and one branch at the caller, which runs
+        // this over many boxes in a row (the polygon map's loop over its patches).
+        (self.min.x <= other.max.x)
+            & (other.min.x <= self.max.x)
+            & (self.min.y <= other.max.y)
+            & (other.min.y <= self.max.y)
+            & (self.min.z <= other.max.z)
+            & (other.min.z <= self.max.z)
     }
 
     /// The centre of the box.
+    #[inline]
     pub fn center(&self) -> Point3 {
         na::center(&self.min, &self.max)
     }
 
     /// The edge lengths of the box (zero for an empty box).
+    #[inline]
     pub fn extents(&self) -> Vector3 {
         if self.is_empty() { Vector3::zeros() } else { self.max - self.min }
     }

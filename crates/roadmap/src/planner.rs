@@ -155,6 +155,10 @@ impl<'a, M: UnspecificStepIntersector + ?Sized> Checker<'a, M> {
     }
 }
 
+/// The most iterations [`Solution::reserve_for`] reserves room for (a larger budget grows
+/// the roadmap as it goes beyond that).
+const MAX_RESERVED: u64 = 1 << 18;
+
 /// What a specific capsule check found.
 pub(crate) enum Contact {
     /// The step is free.
@@ -245,6 +249,16 @@ impl Solution {
         self.goals = goals.to_vec();
         self.reached = vec![None; goals.len()];
         self.counters = PlannerCounters::default();
+    }
+
+    /// Reserves room for a tree that adds at most one vertex and edge per iteration, for
+    /// `budget` iterations (at most [`MAX_RESERVED`] of them), so the roadmap is not copied
+    /// as it grows. `None` reserves nothing.
+    pub(crate) fn reserve_for(&mut self, budget: Option<u64>) {
+        let Some(budget) = budget else { return };
+        let room = usize::try_from(budget.min(MAX_RESERVED)).unwrap_or(0);
+        self.graph.reserve_nodes((room + 1).saturating_sub(self.graph.node_count()));
+        self.graph.reserve_edges(room.saturating_sub(self.graph.edge_count()));
     }
 
     pub(crate) fn goals_reached(&self) -> usize {

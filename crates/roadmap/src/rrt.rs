@@ -143,6 +143,7 @@ pub(crate) fn solve_rrt<'m, M: UnspecificStepIntersector + ?Sized>(
 ) -> PlannerStatus {
     let started = Instant::now();
     solution.reset(&problem.goals);
+    solution.reserve_for(stop.iteration_budget());
     let mut checker = Checker::new(map, space.robot_radius());
     if let Some(invalid) = planner::validate(problem, space, &mut checker) {
         solution.finish(0, &checker);
@@ -222,11 +223,12 @@ pub(crate) fn sample(
     config: &RrtConfig,
     solution: &Solution,
 ) -> (Point3, bool) {
-    let unreached: Vec<usize> =
-        (0..solution.goals.len()).filter(|&g| solution.reached[g].is_none()).collect();
-    if unreached.is_empty() {
+    // Every goal reached (or none, as when exploring): no list to make.
+    if solution.reached.iter().all(Option::is_some) {
         return (planner::uniform(rng, space), false);
     }
+    let unreached: Vec<usize> =
+        (0..solution.goals.len()).filter(|&g| solution.reached[g].is_none()).collect();
     let bias = if config.goal_bias.is_nan() { 0.0 } else { config.goal_bias.clamp(0.0, 1.0) };
     if bias > 0.0 && rng.random::<Real>() < bias {
         return (solution.goals[unreached[rng.random_range(0..unreached.len())]].center, true);

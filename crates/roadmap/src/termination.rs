@@ -34,11 +34,22 @@ impl Progress {
 pub trait Termination {
     /// `true` to stop now.
     fn should_stop(&mut self, progress: &Progress) -> bool;
+
+    /// The most iterations this condition lets a planner run, if it bounds them (`None`:
+    /// unknown). Only a hint for reserving room up front; stopping is still decided by
+    /// [`should_stop`](Termination::should_stop).
+    fn iteration_budget(&self) -> Option<u64> {
+        None
+    }
 }
 
 impl<T: Termination + ?Sized> Termination for &mut T {
     fn should_stop(&mut self, progress: &Progress) -> bool {
         (**self).should_stop(progress)
+    }
+
+    fn iteration_budget(&self) -> Option<u64> {
+        (**self).iteration_budget()
     }
 }
 
@@ -49,6 +60,10 @@ pub struct MaxIterations(pub u64);
 impl Termination for MaxIterations {
     fn should_stop(&mut self, progress: &Progress) -> bool {
         progress.iterations >= self.0
+    }
+
+    fn iteration_budget(&self) -> Option<u64> {
+        Some(self.0)
     }
 }
 
@@ -81,6 +96,14 @@ impl<A: Termination, B: Termination> Termination for AnyOf<A, B> {
     fn should_stop(&mut self, progress: &Progress) -> bool {
         self.0.should_stop(progress) | self.1.should_stop(progress)
     }
+
+    /// The smaller budget of the two (either one stops the run).
+    fn iteration_budget(&self) -> Option<u64> {
+        match (self.0.iteration_budget(), self.1.iteration_budget()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -107,5 +130,20 @@ mod tests {
         assert!(any.should_stop(&progress(1, 2)));
         let dynamic: &mut dyn Termination = &mut any;
         assert!(dynamic.should_stop(&progress(7, 0)));
+    }
+
+    #[test]
+    fn iteration_budgets() {
+        assert_eq!(MaxIterations(7).iteration_budget(), Some(7));
+        assert_eq!(GoalReached.iteration_budget(), None);
+        assert_eq!(Deadline(Instant::now()).iteration_budget(), None);
+        assert_eq!(AnyOf(MaxIterations(5), GoalReached).iteration_budget(), Some(5));
+        assert_eq!(AnyOf(GoalReached, MaxIterations(5)).iteration_budget(), Some(5));
+        assert_eq!(AnyOf(MaxIterations(9), MaxIterations(4)).iteration_budget(), Some(4));
+        assert_eq!(AnyOf(GoalReached, GoalReached).iteration_budget(), None);
+        // Through the forwarding impl for `&mut T`.
+        let mut max = MaxIterations(3);
+        let forwarded: &mut dyn Termination = &mut max;
+        assert_eq!(Termination::iteration_budget(&forwarded), Some(3));
     }
 }
