@@ -634,6 +634,9 @@ enum Graph<'a> {
         /// a chain of links iff their runs start at the same pixel.
         row_runs: Vec<u32>,
         col_runs: Vec<u32>,
+        /// Per pixel, its links to the pixel on its left and the one above ([`LEFT`],
+        /// [`LEFT_LINKED`], [`UP`], [`UP_LINKED`]).
+        links: Vec<u8>,
     },
     Lists {
         /// `neighbours[offsets[i]..offsets[i + 1]]` are point `i`'s neighbours.
@@ -651,8 +654,16 @@ impl<'a> Graph<'a> {
             }
         }
         let strides = seed_strides(grid, &pixel_of, points, config);
-        let (row_runs, col_runs) = link_runs(grid, points, config);
-        Graph::Grid { grid, pixel_of, seed_radius: config.seed_radius, strides, row_runs, col_runs }
+        let (row_runs, col_runs, links) = link_runs(grid, points, config);
+        Graph::Grid {
+            grid,
+            pixel_of,
+            seed_radius: config.seed_radius,
+            strides,
+            row_runs,
+            col_runs,
+            links,
+        }
     }
 
     fn knn(points: &[Point3], k: usize, radius: Real) -> Graph<'static> {
@@ -683,7 +694,8 @@ impl<'a> Graph<'a> {
     /// not: an incomplete window, or one wider than [`MAX_WINDOW_SPAN`] (then
     /// [`seed_window_general`] takes it); for k-NN lists always `Incomplete`.
     fn grid_window(&self, i: usize, members: &mut [u32; WINDOW_CAPACITY]) -> GridWindow {
-        let Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs } = self else {
+        let Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs, .. } = self
+        else {
             return GridWindow::Incomplete;
         };
         let (w, h, s) = (grid.width(), grid.height(), *seed_radius);
@@ -739,34 +751,31 @@ impl<'a> Graph<'a> {
         GridWindow::Members(len, chained)
     }
 
-    /// The growth neighbours of point `i`.
-    fn neighbours(&self, i: usize, out: &mut Vec<u32>) {
+    /// The growth neighbours of point `i` (on a grid: left, right, above, below), each with
+    /// whether the plain jump test (stretch 1) links it to `i`, where the graph knows it (grids).
+    fn neighbours(&self, i: usize, out: &mut Vec<(u32, Option<bool>)>) {
         out.clear();
         match self {
-            Graph::Grid { grid, pixel_of, .. } => {
-                let (w, h) = (grid.width(), grid.height());
-                let pixel = pixel_of[i];
-                let (col, row) = (pixel % w, pixel / w);
-                let mut push = |c: u32, r: u32| {
-                    if let Some(p) = grid.point_index(c, r) {
-                        out.push(p as u32);
+            Graph::Grid { grid, pixel_of, links, .. } => {
+                let (w, pixels) = (grid.width() as usize, grid.pixels());
+                let pixel = pixel_of[i] as usize;
+                // A neighbour's bits are its own (left, above) or the pixel's on its other side
+                // (right, below); pixels past the grid have none.
+                let bits = |at: usize| links.get(at).copied().unwrap_or(0);
+                let mut push = |at: usize, exists: bool, linked: bool| {
+                    if exists {
+                        out.push((pixels[at], Some(linked)));
                     }
                 };
-                if col > 0 {
-                    push(col - 1, row);
-                }
-                if col + 1 < w {
-                    push(col + 1, row);
-                }
-                if row > 0 {
-                    push(col, row - 1);
-                }
-                if row + 1 < h {
-                    push(col, row + 1);
-                }
+                let (here, right, below) = (bits(pixel), bits(pixel + 1), bits(pixel + w));
+                push(pixel.wrapping_sub(1), here & LEFT != 0, here & LEFT_LINKED != 0);
+                push(pixel + 1, right & LEFT != 0, right & LEFT_LINKED != 0);
+                push(pixel.wrapping_sub(w), here & UP != 0, here & UP_LINKED != 0);
+                push(pixel + w, below & UP != 0, below & UP_LINKED != 0);
             }
             Graph::Lists { offsets, neighbours } => {
-                out.extend_from_slice(&neighbours[offsets[i] as usize..offsets[i + 1] as usize]);
+                let list = &neighbours[offsets[i] as usize..offsets[i + 1] as usize];
+                out.extend(list.iter().map(|&m| (m, None)));
             }
         }
     }
@@ -777,7 +786,7 @@ impl<'a> Graph<'a> {
     fn seed_window(&self, i: usize, out: &mut Vec<(u32, u32)>) -> Option<bool> {
         out.clear();
         match self {
-            Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs } => {
+            Graph::Grid { grid, pixel_of, seed_radius, strides, row_runs, col_runs, .. } => {
                 let mut members = [0u32; WINDOW_CAPACITY];
                 match self.grid_window(i, &mut members) {
                     GridWindow::Members(len, chained) => {
@@ -1045,36 +1054,58 @@ impl AngleTest {
     }
 }
 
+/// A pixel's bit in [`Graph::Grid`]'s `links`: it and the pixel on its left are valid.
+const LEFT: u8 = 1;
+/// ... and the plain jump test (stretch 1) links them.
+const LEFT_LINKED: u8 = 2;
+/// A pixel's bit: it and the pixel above are valid.
+const UP: u8 = 4;
+/// ... and the plain jump test links them.
+const UP_LINKED: u8 = 8;
+
 /// Per pixel, the first pixel of its run of linked pixels along its row and along its column
-/// ([`Graph::Grid`]'s `row_runs`, `col_runs`); invalid pixels are runs of their own.
-fn link_runs(grid: &Grid, points: &[Point3], config: &SegmentConfig) -> (Vec<u32>, Vec<u32>) {
+/// ([`Graph::Grid`]'s `row_runs`, `col_runs`; invalid pixels are runs of their own), and its
+/// links to the pixels on its left and above (`links`).
+fn link_runs(
+    grid: &Grid,
+    points: &[Point3],
+    config: &SegmentConfig,
+) -> (Vec<u32>, Vec<u32>, Vec<u8>) {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
-    let linked = |a: usize, b: usize| match (grid.pixels()[a], grid.pixels()[b]) {
+    let pixels = grid.pixels();
+    // The bits of the pair `a`, `b` (the pixel `b` left of or below `a`): both valid, linked.
+    let link = |a: usize, b: usize, valid: u8, linked: u8| match (pixels[a], pixels[b]) {
         (pa, pb) if pa != INVALID_PIXEL && pb != INVALID_PIXEL => {
             let (p, q) = (points[pa as usize], points[pb as usize]);
-            (p - q).norm() <= config.jump_limit(p.coords.norm().max(q.coords.norm()), 1.0)
+            let jump =
+                (p - q).norm() <= config.jump_limit(p.coords.norm().max(q.coords.norm()), 1.0);
+            if jump { valid | linked } else { valid }
         }
-        _ => false,
+        _ => 0,
     };
+    let mut links = vec![0u8; w * h];
     let mut row_runs: Vec<u32> = (0..(w * h) as u32).collect();
     let mut col_runs = row_runs.clone();
     for r in 0..h {
-        for c in 1..w {
-            let (a, b) = (r * w + c - 1, r * w + c);
-            if linked(a, b) {
-                row_runs[b] = row_runs[a];
-            }
-        }
-    }
-    for r in 1..h {
         for c in 0..w {
-            let (a, b) = ((r - 1) * w + c, r * w + c);
-            if linked(a, b) {
-                col_runs[b] = col_runs[a];
+            let b = r * w + c;
+            let mut bits = 0;
+            if c > 0 {
+                bits |= link(b - 1, b, LEFT, LEFT_LINKED);
             }
+            if r > 0 {
+                bits |= link(b - w, b, UP, UP_LINKED);
+            }
+            if bits & LEFT_LINKED != 0 {
+                row_runs[b] = row_runs[b - 1];
+            }
+            if bits & UP_LINKED != 0 {
+                col_runs[b] = col_runs[b - w];
+            }
+            links[b] = bits;
         }
     }
-    (row_runs, col_runs)
+    (row_runs, col_runs, links)
 }
 
 /// Per-point quantities and the thresholds derived from the configuration.
@@ -1096,17 +1127,16 @@ impl Tests<'_> {
     /// The factor ≥ 1 on the jump test's range part for a plane seen from `point` (sensor
     /// frame) ([`GrazingPlanes::link_cos`]); 1 unless the plane is seen grazingly.
     fn stretch(&self, normal: &Vector3, point: &Vector3) -> Real {
+        let Some(g) = self.config.grazing else { return 1.0 };
         let range = point.norm();
-        match self.config.grazing {
-            Some(g) if range > 0.0 => {
-                let c = normal.dot(point).abs() / range;
-                if c < self.config.min_incidence_cos {
-                    (g.link_cos / c.max(g.min_cos)).max(1.0)
-                } else {
-                    1.0
-                }
-            }
-            _ => 1.0,
+        if range.is_nan() || range <= 0.0 {
+            return 1.0;
+        }
+        let c = normal.dot(point).abs() / range;
+        if c < self.config.min_incidence_cos {
+            (g.link_cos / c.max(g.min_cos)).max(1.0)
+        } else {
+            1.0
         }
     }
 
@@ -1124,9 +1154,13 @@ impl Tests<'_> {
     }
 
     /// The jump test between region point `q` and its neighbour `m` while growing a region
-    /// with `plane` ([`GrazingPlanes::link_cos`]).
-    fn linked_on(&self, plane: &Plane, q: usize, m: usize) -> bool {
-        self.linked_by(q, m, self.stretch(&plane.normal, &self.points[q].coords))
+    /// with `plane` ([`GrazingPlanes::link_cos`]); `plain`: the plain test's answer (stretch
+    /// 1), if known.
+    fn linked_on(&self, plane: &Plane, q: usize, m: usize, plain: Option<bool>) -> bool {
+        match (self.stretch(&plane.normal, &self.points[q].coords), plain) {
+            (1.0, Some(linked)) => linked,
+            (stretch, _) => self.linked_by(q, m, stretch),
+        }
     }
 
     fn near_plane(&self, plane: &Plane, m: usize) -> bool {
@@ -1761,10 +1795,10 @@ fn grow_counted(
             let q = queue[head] as usize;
             head += 1;
             graph.neighbours(q, &mut nbrs);
-            for &m in &nbrs {
+            for &(m, linked) in &nbrs {
                 let m = m as usize;
                 if owner[m] != FREE
-                    || !tests.linked_on(&plane, q, m)
+                    || !tests.linked_on(&plane, q, m, linked)
                     || !tests.near_plane(&plane, m)
                     || window_normal.get_mut(m).is_some_and(|w| {
                         let refused = |w: &Vector3| {
