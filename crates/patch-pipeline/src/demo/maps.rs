@@ -246,8 +246,8 @@ pub fn build_maps(
         if Some(&kind) == kinds.last() {
             let t0 = Instant::now();
             let points: Vec<Point3> = crate::scene_map::pc_points(scans, &Default::default())?;
-            let parked = ParkedPoints::park(points, &files.path(""))?;
-            pc = Some((parked, scans.len(), t0.elapsed().as_secs_f64()));
+            let gathered = t0.elapsed().as_secs_f64();
+            pc = Some((ParkedPoints::park(points, &files.path(""))?, scans.len(), gathered));
             clouds = None;
         }
         bar.inc(1);
