@@ -1073,7 +1073,7 @@ fn link_runs(
 ) -> (Vec<u32>, Vec<u32>, Vec<u8>) {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
     let pixels = grid.pixels();
-    // The bits of the pair `a`, `b` (the pixel `b` left of or below `a`): both valid, linked.
+    // The bits of the pair `a`, `b` (`a` the pixel left of or above `b`): both valid, linked.
     let link = |a: usize, b: usize, valid: u8, linked: u8| match (pixels[a], pixels[b]) {
         (pa, pb) if pa != INVALID_PIXEL && pb != INVALID_PIXEL => {
             let (p, q) = (points[pa as usize], points[pb as usize]);
@@ -1725,8 +1725,7 @@ fn grow_counted(
     let mut queue: Vec<u32> = Vec::new();
     let mut nbrs = Vec::new();
     loop {
-        let closed = |p: usize| owner[p] != FREE || spent[p];
-        let next = seeds.peek(closed);
+        let next = seeds.peek(closed(&owner, &spent));
         let from_list = match (next, fitted.peek()) {
             (Some(s), Some(Reverse(f))) => s < *f,
             (Some(_), None) => true,
@@ -1764,7 +1763,7 @@ fn grow_counted(
                 }
             };
             let exact = Seed::new(curvature, seed as u32, true);
-            if seeds.peek(|p| owner[p] != FREE || spent[p]).is_some_and(|s| s < exact)
+            if seeds.peek(closed(&owner, &spent)).is_some_and(|s| s < exact)
                 || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
             {
                 fitted.push(Reverse(exact));
@@ -1898,6 +1897,11 @@ fn grow_counted(
     sort_largest_first(&mut regions);
     let remainder = (0..n as u32).filter(|&i| matches!(owner[i as usize], FREE | BENT)).collect();
     (Segmentation { regions, remainder }, taken)
+}
+
+/// Whether a point is closed to seeds: taken by a region (or bent) or spent.
+fn closed<'a>(owner: &'a [u32], spent: &'a [bool]) -> impl Fn(usize) -> bool + 'a {
+    |p| owner[p] != FREE || spent[p]
 }
 
 /// Largest region first, ties by the smallest point index ([`Segmentation::regions`]' order).

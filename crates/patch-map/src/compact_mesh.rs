@@ -118,10 +118,7 @@ impl Items {
             .iter()
             .map(|t| {
                 let mut b = Bounds::EMPTY;
-                for &i in t {
-                    let p = &vertices[i as usize];
-                    b.add_point(&[p.x, p.y, p.z]);
-                }
+                b.add_triangle(vertices, t);
                 Item {
                     min: [0, 1, 2].map(|k| at(b.min[k], k).floor() as u16),
                     max: [0, 1, 2].map(|k| at(b.max[k], k).ceil() as u16),
@@ -178,6 +175,14 @@ impl Bounds {
             if x > self.max[k] {
                 self.max[k] = x;
             }
+        }
+    }
+
+    /// Grows the box by the triangle `t` of `vertices`.
+    fn add_triangle(&mut self, vertices: &[Point3], t: &[u32; 3]) {
+        for &i in t {
+            let p = &vertices[i as usize];
+            self.add_point(&[p.x, p.y, p.z]);
         }
     }
 
@@ -275,10 +280,7 @@ impl CompactMesh {
             let mut bounds = Bounds::EMPTY;
             if count > 0 {
                 for t in &indices[first..first + count] {
-                    for &v in t {
-                        let p = &vertices[v as usize];
-                        bounds.add_point(&[p.x, p.y, p.z]);
-                    }
+                    bounds.add_triangle(&vertices, t);
                 }
             } else {
                 for child in &nodes[first..first + 2] {
