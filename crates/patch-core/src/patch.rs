@@ -64,6 +64,7 @@ pub struct Plane {
 
 impl Plane {
     /// `normal · p − offset`: positive on the side the normal points to.
+    #[inline]
     pub fn signed_distance(&self, p: &Point3) -> Real {
         self.normal.dot(&p.coords) - self.offset
     }

@@ -546,8 +546,9 @@ pub fn segment_with_threads(
     config.validate()?;
     match cloud.grid() {
         Some(grid) if !cloud.is_empty() => {
-            let graph = Graph::grid(grid, cloud.positions(), config);
-            Ok(grow(cloud.positions(), &graph, config, up(cloud), threads))
+            let tests = Tests::new(cloud.positions(), config, up(cloud));
+            let graph = Graph::grid(grid, &tests);
+            Ok(grow(&graph, &tests, threads))
         }
         _ => segment_unorganised(cloud, config),
     }
@@ -617,7 +618,8 @@ pub fn segment_unorganised(
         return Ok(Segmentation::default());
     }
     let graph = Graph::knn(cloud.positions(), config.knn, config.knn_radius);
-    Ok(grow(cloud.positions(), &graph, config, up(cloud), NonZeroUsize::MIN))
+    let tests = Tests::new(cloud.positions(), config, up(cloud));
+    Ok(grow(&graph, &tests, NonZeroUsize::MIN))
 }
 
 /// Neighbourhoods of the points: pixel grid or k-NN lists.
@@ -627,8 +629,8 @@ enum Graph<'a> {
         /// Per point: its pixel (row-major index).
         pixel_of: Vec<u32>,
         seed_radius: u32,
-        /// Per point: the seed window's strides along columns and rows (0: no window).
-        strides: Vec<[u8; 2]>,
+        /// Per point: the seed window's strides along columns and rows.
+        strides: Strides,
         /// Per pixel: the first pixel of its run along its row (column) of valid pixels each
         /// linked to the next by the jump test; two pixels of one row (column) are joined by
         /// a chain of links iff their runs start at the same pixel.
@@ -646,7 +648,8 @@ enum Graph<'a> {
 }
 
 impl<'a> Graph<'a> {
-    fn grid(grid: &'a Grid, points: &[Point3], config: &SegmentConfig) -> Graph<'a> {
+    fn grid(grid: &'a Grid, tests: &Tests<'_>) -> Graph<'a> {
+        let (points, config) = (tests.points, tests.config);
         let mut pixel_of = vec![INVALID_PIXEL; points.len()];
         for (pixel, &p) in grid.pixels().iter().enumerate() {
             if p != INVALID_PIXEL {
@@ -654,7 +657,7 @@ impl<'a> Graph<'a> {
             }
         }
         let strides = seed_strides(grid, &pixel_of, points, config);
-        let (row_runs, col_runs, links) = link_runs(grid, points, config);
+        let (row_runs, col_runs, links) = link_runs(grid, tests);
         Graph::Grid {
             grid,
             pixel_of,
@@ -701,7 +704,7 @@ impl<'a> Graph<'a> {
         let (w, h, s) = (grid.width(), grid.height(), *seed_radius);
         let pixel = pixel_of[i];
         let (col, row) = (pixel % w, pixel / w);
-        let [tc, tr] = strides[i].map(u32::from);
+        let [tc, tr] = strides.of(i);
         let (sc, sr) = (s * tc, s * tr);
         if tc == 0 || tr == 0 || col < sc || row < sr || col + sc >= w || row + sr >= h {
             return GridWindow::Incomplete;
@@ -797,7 +800,7 @@ impl<'a> Graph<'a> {
                     GridWindow::Wide => {
                         let (w, s) = (grid.width(), *seed_radius);
                         let pixel = pixel_of[i];
-                        let [tc, tr] = strides[i].map(u32::from);
+                        let [tc, tr] = strides.of(i);
                         seed_window_general(
                             grid,
                             row_runs,
@@ -828,7 +831,7 @@ impl<'a> Graph<'a> {
         };
         let w = grid.width();
         let (col, row) = (pixel_of[i] % w, pixel_of[i] / w);
-        let [tc, tr] = strides[i].map(u32::from);
+        let [tc, tr] = strides.of(i);
         let (sc, sr) = (seed_radius * tc, seed_radius * tr);
         let point = |c: u32, r: u32| grid.point_index(c, r);
         let walk = |from: (u32, u32), to: (u32, u32)| -> bool {
@@ -950,17 +953,34 @@ pub const RANGE_CAMERA_MAX_BENDING: Real = 0.3;
 /// together: 25° from the axis a 0.5° pitch step moves the beam by 0.21°).
 const MAX_SEED_STRIDE: u32 = 32;
 
-/// Per point: the strides of its seed window along columns and rows (module docs, step 1;
-/// `[1, 1]` for every point when `seed_min_extent` is 0), `0` where no stride up to
-/// [`MAX_SEED_STRIDE`] widens the window enough.
+/// Per point: the strides of its seed window along columns and rows (module docs, step 1).
+enum Strides {
+    /// `[1, 1]` for every point (`seed_min_extent` is 0).
+    Ones,
+    /// `0` where no stride up to [`MAX_SEED_STRIDE`] widens the window enough.
+    Each(Vec<[u8; 2]>),
+}
+
+impl Strides {
+    /// Point `i`'s strides.
+    #[inline]
+    fn of(&self, i: usize) -> [u32; 2] {
+        match self {
+            Strides::Ones => [1, 1],
+            Strides::Each(strides) => strides[i].map(u32::from),
+        }
+    }
+}
+
+/// The points' [`Strides`].
 fn seed_strides(
     grid: &Grid,
     pixel_of: &[u32],
     points: &[Point3],
     config: &SegmentConfig,
-) -> Vec<[u8; 2]> {
+) -> Strides {
     if config.seed_min_extent <= 0.0 {
-        return vec![[1, 1]; points.len()];
+        return Strides::Ones;
     }
     let (w, h, s) = (grid.width() as usize, grid.height() as usize, config.seed_radius as usize);
     let pixels = grid.pixels();
@@ -973,7 +993,7 @@ fn seed_strides(
             p => points[p as usize].coords / points[p as usize].coords.norm(),
         })
         .collect();
-    points
+    let strides = points
         .iter()
         .enumerate()
         .map(|(i, p)| {
@@ -1006,7 +1026,8 @@ fn seed_strides(
             };
             [stride(1, col.min(w - 1 - col)), stride(w, row.min(h - 1 - row))]
         })
-        .collect()
+        .collect();
+    Strides::Each(strides)
 }
 
 /// The test `angle(a, b) ≥ needed` of [`seed_strides`] for the angle
@@ -1066,20 +1087,13 @@ const UP_LINKED: u8 = 8;
 /// Per pixel, the first pixel of its run of linked pixels along its row and along its column
 /// ([`Graph::Grid`]'s `row_runs`, `col_runs`; invalid pixels are runs of their own), and its
 /// links to the pixels on its left and above (`links`).
-fn link_runs(
-    grid: &Grid,
-    points: &[Point3],
-    config: &SegmentConfig,
-) -> (Vec<u32>, Vec<u32>, Vec<u8>) {
+fn link_runs(grid: &Grid, tests: &Tests<'_>) -> (Vec<u32>, Vec<u32>, Vec<u8>) {
     let (w, h) = (grid.width() as usize, grid.height() as usize);
     let pixels = grid.pixels();
     // The bits of the pair `a`, `b` (`a` the pixel left of or above `b`): both valid, linked.
     let link = |a: usize, b: usize, valid: u8, linked: u8| match (pixels[a], pixels[b]) {
         (pa, pb) if pa != INVALID_PIXEL && pb != INVALID_PIXEL => {
-            let (p, q) = (points[pa as usize], points[pb as usize]);
-            let jump =
-                (p - q).norm() <= config.jump_limit(p.coords.norm().max(q.coords.norm()), 1.0);
-            if jump { valid | linked } else { valid }
+            if tests.linked(pa as usize, pb as usize, 1) { valid | linked } else { valid }
         }
         _ => 0,
     };
@@ -1111,14 +1125,21 @@ fn link_runs(
 /// Per-point quantities and the thresholds derived from the configuration.
 struct Tests<'a> {
     points: &'a [Point3],
+    /// Per point: its range.
     range: Vec<Real>,
-    sigma: Vec<Real>,
+    sigma: Sigmas,
     config: &'a SegmentConfig,
     /// The world's up in the sensor frame.
     up: Vector3,
 }
 
-impl Tests<'_> {
+impl<'a> Tests<'a> {
+    fn new(points: &'a [Point3], config: &'a SegmentConfig, up: Vector3) -> Tests<'a> {
+        let range: Vec<Real> = points.iter().map(|p| p.coords.norm()).collect();
+        let sigma = Sigmas::new(&config.noise, &range);
+        Tests { points, range, sigma, config, up }
+    }
+
     fn linked(&self, a: usize, b: usize, steps: u32) -> bool {
         let limit = self.config.jump_limit(self.range[a].max(self.range[b]), 1.0);
         (self.points[a] - self.points[b]).norm() <= limit * steps as Real
@@ -1164,7 +1185,8 @@ impl Tests<'_> {
     }
 
     fn near_plane(&self, plane: &Plane, m: usize) -> bool {
-        plane.signed_distance(&self.points[m]).abs() <= self.config.distance_factor * self.sigma[m]
+        plane.signed_distance(&self.points[m]).abs()
+            <= self.config.distance_factor * self.sigma.of(m)
     }
 
     /// The incidence test of a region's plane (`seed`: of a seed window's).
@@ -1191,6 +1213,34 @@ impl Tests<'_> {
     fn mse_ok(&self, mse: Real, sum_sigma2: Real, count: usize) -> bool {
         let f = self.config.mse_factor;
         mse <= f * f * sum_sigma2 / count as Real
+    }
+}
+
+/// Each point's σ, the noise model at its range ([`RangeNoise::sigma`]): one value where the
+/// model is constant, which is then exactly each point's σ (it saves a frame's worth of
+/// memory on the hot path of range cameras).
+enum Sigmas {
+    Same(Real),
+    Each(Vec<Real>),
+}
+
+impl Sigmas {
+    fn new(noise: &RangeNoise, range: &[Real]) -> Sigmas {
+        // `sigma_0 + 0 · r²` is `sigma_0` unless `r²` overflows.
+        if noise.sigma_r2 == 0.0 && range.iter().all(|r| (r * r).is_finite()) {
+            Sigmas::Same(noise.sigma_0)
+        } else {
+            Sigmas::Each(range.iter().map(|&r| noise.sigma(r)).collect())
+        }
+    }
+
+    /// Point `i`'s σ.
+    #[inline]
+    fn of(&self, i: usize) -> Real {
+        match self {
+            Sigmas::Same(sigma) => *sigma,
+            Sigmas::Each(sigma) => sigma[i],
+        }
     }
 }
 
@@ -1223,7 +1273,7 @@ const CHI2_3_999: Real = 16.266;
 fn bending(
     points: &[Point3],
     region: &[u32],
-    sigma: &[Real],
+    sigma: &Sigmas,
     acc: &PlaneAccumulator,
 ) -> Option<Real> {
     let fit = acc.fit(&Point3::origin())?;
@@ -1241,7 +1291,8 @@ fn bending(
     for &i in region {
         let q = points[i as usize] - fit.centroid;
         let (u, v, d) = (q.dot(&e1), q.dot(&e2), q.dot(&normal));
-        let w = 1.0 / (sigma[i as usize] * sigma[i as usize]);
+        let s = sigma.of(i as usize);
+        let w = 1.0 / (s * s);
         let phi = nalgebra::Vector6::new(1.0, u, v, u * u, u * v, v * v);
         a.syger(w, &phi, &phi, 1.0);
         b.axpy(w * d, &phi, 1.0);
@@ -1272,80 +1323,98 @@ impl Seed {
         ((self.0 >> 1) as u32) as usize
     }
 
+    /// The curvature's order key (the top 64 bits).
+    fn key(self) -> u64 {
+        (self.0 >> 64) as u64
+    }
+
     fn fitted(self) -> bool {
         self.0 & 1 == 1
     }
 }
 
-/// Bits of a [`SeedQueue`]'s bucket index: at most 4,096 buckets.
-const SEED_BUCKET_BITS: u32 = 12;
+/// Bits of each of a [`SeedQueue`]'s two bucket levels: up to 64 coarse buckets of up to 64
+/// fine ones.
+const SEED_BUCKET_BITS: u32 = 6;
 
-/// The seeds in ascending order, sorted lazily. One counting pass spreads them into buckets
-/// of increasing curvature keys (the key's integer range split evenly); a bucket is sorted
-/// only when the growth reaches it, and first loses the seeds whose points are taken or spent
-/// by then. That drops nothing still to be tried: between two seeds a taken point stays taken
-/// (a dissolved region frees only the points it took, before the next seed) and a spent one
-/// stays spent. On a VGA frame most seeds are taken before their bucket comes up, so this
-/// replaces sorting 250,000–300,000 seeds (with a second array of them) by sorting a few
-/// thousand.
+/// The seeds in ascending order, sorted lazily. The key's integer range is split evenly into
+/// up to 4,096 fine buckets, 64 to a coarse bucket. An in-place counting pass orders the
+/// seeds by coarse bucket; when the growth reaches a coarse bucket, it loses the seeds whose
+/// points are taken or spent by then and is ordered by fine bucket the same way; a fine
+/// bucket is sorted when the growth reaches it, again without the seeds closed by then. That
+/// drops nothing still to be tried: between two seeds a taken point stays taken (a dissolved
+/// region frees only the points it took, before the next seed) and a spent one stays spent.
+/// On a VGA frame most seeds are taken before their bucket comes up, so this replaces
+/// sorting 250,000–300,000 seeds by sorting a few thousand, with no second array of seeds;
+/// and with at most 64 buckets per pass the in-place passes write to 64 places at a time,
+/// which stay in cache (4,096 at once cost a cache and TLB miss per seed).
 struct SeedQueue {
-    /// The seeds, bucket after bucket.
+    /// The seeds: by coarse bucket; the current coarse bucket by fine bucket.
     seeds: Vec<Seed>,
-    /// `seeds[starts[b]..starts[b + 1]]` is bucket `b`.
-    starts: Vec<usize>,
-    /// The next bucket to prepare.
-    bucket: usize,
-    /// The prepared (open, sorted) seeds of the current bucket still to come: `next..end`.
+    /// The smallest key, and the shift that maps `key - min` to its fine bucket's index over
+    /// all coarse buckets.
+    min: u64,
+    shift: u32,
+    /// `seeds[coarse[c]..coarse[c + 1]]` is coarse bucket `c`; the next one to prepare.
+    coarse: Vec<usize>,
+    next_coarse: usize,
+    /// The current coarse bucket's open seeds, by fine bucket (bounds as `coarse`); the next
+    /// fine bucket to prepare.
+    fine: Vec<usize>,
+    next_fine: usize,
+    /// The prepared (open, sorted) seeds of the current fine bucket still to come:
+    /// `next..end`.
     next: usize,
     end: usize,
 }
 
 impl SeedQueue {
-    /// The queue of the seeds of all `parts`.
-    fn new(parts: Vec<Vec<Seed>>) -> SeedQueue {
-        let key = |s: &Seed| (s.0 >> 64) as u64;
-        let (min, max) = parts
-            .iter()
-            .flatten()
-            .fold((u64::MAX, 0), |(lo, hi), s| (lo.min(key(s)), hi.max(key(s))));
-        let total: usize = parts.iter().map(Vec::len).sum();
-        if total == 0 {
-            return SeedQueue { seeds: Vec::new(), starts: vec![0], bucket: 0, next: 0, end: 0 };
+    /// The queue of `packed` seeds ([`Seed`]'s `u128`), in any order.
+    fn new(packed: Vec<u128>) -> SeedQueue {
+        let mut seeds: Vec<Seed> = packed.into_iter().map(Seed).collect();
+        let (min, max) =
+            seeds.iter().fold((u64::MAX, 0), |(lo, hi), s| (lo.min(s.key()), hi.max(s.key())));
+        let (min, max) = if seeds.is_empty() { (0, 0) } else { (min, max) };
+        let shift = (u64::BITS - (max - min).leading_zeros()).saturating_sub(2 * SEED_BUCKET_BITS);
+        let buckets = (((max - min) >> shift >> SEED_BUCKET_BITS) + 1) as usize;
+        let coarse = partition_seeds(&mut seeds, buckets, |s| {
+            ((s.key() - min) >> shift >> SEED_BUCKET_BITS) as usize
+        });
+        SeedQueue {
+            seeds,
+            min,
+            shift,
+            coarse,
+            next_coarse: 0,
+            fine: vec![0],
+            next_fine: 0,
+            next: 0,
+            end: 0,
         }
-        let shift = (u64::BITS - (max - min).leading_zeros()).saturating_sub(SEED_BUCKET_BITS);
-        let bucket = |s: &Seed| ((key(s) - min) >> shift) as usize;
-        let mut starts = vec![0; ((max - min) >> shift) as usize + 2];
-        for s in parts.iter().flatten() {
-            starts[bucket(s) + 1] += 1;
-        }
-        for b in 1..starts.len() {
-            starts[b] += starts[b - 1];
-        }
-        let mut fill = starts.clone();
-        let mut seeds = vec![Seed(0); total];
-        for s in parts.into_iter().flatten() {
-            let b = bucket(&s);
-            seeds[fill[b]] = s;
-            fill[b] += 1;
-        }
-        SeedQueue { seeds, starts, bucket: 0, next: 0, end: 0 }
     }
 
     /// The next seed, without taking it; `closed(point)`: whether a point is taken or spent.
     fn peek(&mut self, closed: impl Fn(usize) -> bool) -> Option<Seed> {
         while self.next == self.end {
-            let (&a, &b) = (self.starts.get(self.bucket)?, self.starts.get(self.bucket + 1)?);
-            self.bucket += 1;
-            let mut open = a;
-            for k in a..b {
-                let seed = self.seeds[k];
-                if !closed(seed.point()) {
-                    self.seeds[open] = seed;
-                    open += 1;
-                }
+            if let (Some(&a), Some(&b)) =
+                (self.fine.get(self.next_fine), self.fine.get(self.next_fine + 1))
+            {
+                self.next_fine += 1;
+                let open = a + retain_open(&mut self.seeds[a..b], &closed);
+                self.seeds[a..open].sort_unstable();
+                (self.next, self.end) = (a, open);
+                continue;
             }
-            self.seeds[a..open].sort_unstable();
-            (self.next, self.end) = (a, open);
+            let (&a, &b) =
+                (self.coarse.get(self.next_coarse)?, self.coarse.get(self.next_coarse + 1)?);
+            self.next_coarse += 1;
+            let open = a + retain_open(&mut self.seeds[a..b], &closed);
+            let (min, shift, mask) = (self.min, self.shift, (1 << SEED_BUCKET_BITS) - 1);
+            let fine = partition_seeds(&mut self.seeds[a..open], 1 << SEED_BUCKET_BITS, |s| {
+                ((s.key() - min) >> shift) as usize & mask
+            });
+            self.fine = fine.into_iter().map(|k| a + k).collect();
+            self.next_fine = 0;
         }
         Some(self.seeds[self.next])
     }
@@ -1355,6 +1424,48 @@ impl SeedQueue {
         debug_assert!(self.next < self.end);
         self.next += 1;
     }
+}
+
+/// Moves the seeds of `seeds` whose points are open (not `closed`) to its front, in order;
+/// returns how many.
+fn retain_open(seeds: &mut [Seed], closed: impl Fn(usize) -> bool) -> usize {
+    let mut open = 0;
+    for k in 0..seeds.len() {
+        let seed = seeds[k];
+        if !closed(seed.point()) {
+            seeds[open] = seed;
+            open += 1;
+        }
+    }
+    open
+}
+
+/// Orders `seeds` by `bucket` (< `buckets`) in place, by counts and swaps (each seed moves
+/// once, to its bucket's next free place); returns the `buckets + 1` bucket bounds.
+fn partition_seeds(
+    seeds: &mut [Seed],
+    buckets: usize,
+    bucket: impl Fn(&Seed) -> usize,
+) -> Vec<usize> {
+    let mut starts = vec![0; buckets + 1];
+    for s in seeds.iter() {
+        starts[bucket(s) + 1] += 1;
+    }
+    for b in 1..starts.len() {
+        starts[b] += starts[b - 1];
+    }
+    // `seeds[starts[b]..fill[b]]` hold bucket `b`'s seeds.
+    let mut fill = starts.clone();
+    for b in 0..buckets {
+        while fill[b] < starts[b + 1] {
+            let t = bucket(&seeds[fill[b]]);
+            if t != b {
+                seeds.swap(fill[b], fill[t]);
+            }
+            fill[t] += 1;
+        }
+    }
+    starts
 }
 
 /// The seeds of points `range` (module docs, step 3, and "Performance": certified bounds where
@@ -1514,20 +1625,26 @@ fn box_windows(graph: &Graph<'_>, config: &SegmentConfig) -> bool {
 /// [`TILE`]² centres, relative to a point of the tile so that the sums keep their precision).
 /// Any other window, or one whose sums are not precise enough ([`BOX_SUM_MAX_SPREAD`]), goes
 /// through [`seed_of`]. The bounds are certified either way, so the segmentation is the same
-/// (module docs, "Performance").
+/// (module docs, "Performance"). Writes the packed seeds ([`Seed`]'s `u128`) to the start of
+/// `out`, which has room for one per pixel of `rows`; returns how many.
 fn seeds_in_rows(
     rows: std::ops::Range<usize>,
     points: &[Point3],
     graph: &Graph<'_>,
     tests: &Tests<'_>,
-) -> Vec<Seed> {
+    out: &mut [u128],
+) -> usize {
     let Graph::Grid { grid, seed_radius, row_runs, col_runs, .. } = graph else {
-        return Vec::new();
+        return 0;
     };
     let (w, h, s) = (grid.width() as usize, grid.height() as usize, *seed_radius as usize);
     let pixels = grid.pixels();
     let mut scratch = SeedScratch::default();
-    let mut seeds = Vec::new();
+    let mut len = 0;
+    let mut push = |seed: Seed| {
+        out[len] = seed.0;
+        len += 1;
+    };
     // Per halo pixel: [1, x, y, z, xx, xy, xz, yy, yz, zz] relative to the tile's reference
     // (zero for invalid pixels); per halo row and centre column: the row's box sums.
     let halo = TILE + 2 * s;
@@ -1609,11 +1726,11 @@ fn seeds_in_rows(
                         })
                         .flatten();
                     match bound {
-                        Some(lower) => seeds.push(Seed::new(lower, i as u32, false)),
+                        Some(lower) => push(Seed::new(lower, i as u32, false)),
                         None => {
                             if let Some((seed, _)) = seed_of(i, points, graph, tests, &mut scratch)
                             {
-                                seeds.push(seed);
+                                push(seed);
                             }
                         }
                     }
@@ -1621,7 +1738,7 @@ fn seeds_in_rows(
             }
         }
     }
-    seeds
+    len
 }
 
 /// A region kept by [`grow`]: how many points it took, and their sums.
@@ -1630,23 +1747,19 @@ struct Grown {
     acc: PlaneAccumulator,
 }
 
-fn grow(
-    points: &[Point3],
-    graph: &Graph<'_>,
-    config: &SegmentConfig,
-    up: Vector3,
-    threads: NonZeroUsize,
-) -> Segmentation {
-    grow_counted(points, graph, config, up, threads, true).0
+fn grow(graph: &Graph<'_>, tests: &Tests<'_>, threads: NonZeroUsize) -> Segmentation {
+    grow_counted(graph, tests, threads, true).0
 }
 
 /// `f` of each part, in order: the first on this thread, the others on scoped threads of
 /// their own (a panic in `f` propagates).
-fn in_parts<P: Sync, T: Send>(parts: &[P], f: impl Fn(&P) -> T + Sync) -> Vec<T> {
+fn in_parts<P: Send, T: Send>(parts: Vec<P>, f: impl Fn(P) -> T + Sync) -> Vec<T> {
     std::thread::scope(|s| {
         let f = &f;
-        let handles: Vec<_> = parts.iter().skip(1).map(|p| s.spawn(move || f(p))).collect();
-        let mut out: Vec<T> = parts.first().map(f).into_iter().collect();
+        let mut parts = parts.into_iter();
+        let first = parts.next();
+        let handles: Vec<_> = parts.map(|p| s.spawn(move || f(p))).collect();
+        let mut out: Vec<T> = first.map(f).into_iter().collect();
         out.extend(
             handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))),
         );
@@ -1660,17 +1773,13 @@ const PARALLEL_SEEDS_MIN: usize = 50_000;
 /// [`grow`], and how many times a point was taken by a region (growth work: dissolved
 /// regions count again when their points are taken anew).
 fn grow_counted(
-    points: &[Point3],
     graph: &Graph<'_>,
-    config: &SegmentConfig,
-    up: Vector3,
+    tests: &Tests<'_>,
     threads: NonZeroUsize,
     box_sums: bool,
 ) -> (Segmentation, usize) {
+    let (points, config) = (tests.points, tests.config);
     let n = points.len();
-    let range: Vec<Real> = points.iter().map(|p| p.coords.norm()).collect();
-    let sigma: Vec<Real> = range.iter().map(|&r| config.noise.sigma(r)).collect();
-    let tests = Tests { points, range, sigma, config, up };
     let origin = Point3::origin();
     let min_normal_cos = config.max_normal_angle.map_or(-1.0, Real::cos);
 
@@ -1694,19 +1803,29 @@ fn grow_counted(
         && box_sums
         && box_windows(graph, config)
     {
-        // Bands of whole tiles of rows, one per part.
-        let h = grid.height() as usize;
-        let band = h.div_ceil(parts).div_ceil(TILE) * TILE;
-        let bands: Vec<_> = (0..h).step_by(band.max(1)).map(|r| r..(r + band).min(h)).collect();
-        let seeds = in_parts(&bands, |rows| seeds_in_rows(rows.clone(), points, graph, &tests));
-        (seeds, Vec::new())
+        // Bands of whole tiles of rows, one per part. The seeds go to one zeroed buffer (its
+        // pages are touched only where written), at most one per pixel: each band writes
+        // its seeds at the start of its rows' share, and the shares are closed up after.
+        let (w, h) = (grid.width() as usize, grid.height() as usize);
+        let band = (h.div_ceil(parts).div_ceil(TILE) * TILE).max(1);
+        let mut packed = vec![0u128; w * h];
+        let shares: Vec<_> = (0..h).step_by(band).zip(packed.chunks_mut(band * w)).collect();
+        let counts = in_parts(shares, |(r0, out)| {
+            seeds_in_rows(r0..(r0 + band).min(h), points, graph, tests, out)
+        });
+        let mut len = 0;
+        for (k, count) in counts.into_iter().enumerate() {
+            packed.copy_within(k * band * w..k * band * w + count, len);
+            len += count;
+        }
+        packed.truncate(len);
+        (packed, Vec::new())
     } else {
         let chunk = n.div_ceil(parts);
         let ranges: Vec<_> = (0..parts).map(|k| k * chunk..((k + 1) * chunk).min(n)).collect();
-        let found =
-            in_parts(&ranges, |range| seeds_in(range.clone(), points, graph, &tests, with_normals));
+        let found = in_parts(ranges, |range| seeds_in(range, points, graph, tests, with_normals));
         let (seeds, normals): (Vec<_>, Vec<_>) = found.into_iter().unzip();
-        (seeds, normals.concat())
+        (seeds.into_iter().flatten().map(|s| s.0).collect(), normals.concat())
     };
     let mut window = Vec::new();
     // Flattest first, ties by index (the seeds are distinct: one per point).
@@ -1772,7 +1891,7 @@ fn grow_counted(
         }
         let Some(fit) = fit_now.or_else(|| acc.fit(&origin)) else { continue };
         let mut sum_sigma2: Real =
-            window.iter().map(|&(p, _)| tests.sigma[p as usize].powi(2)).sum();
+            window.iter().map(|&(p, _)| tests.sigma.of(p as usize).powi(2)).sum();
         if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
             || !tests.facing(&fit, true)
             || !window.iter().all(|&(p, _)| tests.near_plane(&fit.plane, p as usize))
@@ -1834,7 +1953,7 @@ fn grow_counted(
                 let (a, b) = (along.0 + d, along.1 + d * d);
                 let count = acc.len() + 1;
                 let mse = ((b - a * a / count as Real) / count as Real).max(0.0);
-                let s2 = sum_sigma2 + tests.sigma[m].powi(2);
+                let s2 = sum_sigma2 + tests.sigma.of(m).powi(2);
                 if !tests.mse_ok(mse, s2, count) {
                     continue;
                 }
@@ -1998,9 +2117,9 @@ mod tests {
         });
         let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
         let config = SegmentConfig::alrf();
-        let graph = Graph::grid(cloud.grid().unwrap(), cloud.positions(), &config);
-        let (seg, taken) =
-            grow_counted(cloud.positions(), &graph, &config, up(&cloud), NonZeroUsize::MIN, true);
+        let tests = Tests::new(cloud.positions(), &config, up(&cloud));
+        let graph = Graph::grid(cloud.grid().unwrap(), &tests);
+        let (seg, taken) = grow_counted(&graph, &tests, NonZeroUsize::MIN, true);
         let n = cloud.len();
         assert!(seg.regions.is_empty(), "{} regions", seg.regions.len());
         assert_eq!(seg.remainder.len(), n);
@@ -2009,11 +2128,12 @@ mod tests {
 
     /// The segmentation with and without box sums of the seed windows, one thread and two.
     fn assert_box_sums_agree(cloud: &PointCloud, config: &SegmentConfig) {
-        let graph = Graph::grid(cloud.grid().unwrap(), cloud.positions(), config);
+        let tests = Tests::new(cloud.positions(), config, up(cloud));
+        let graph = Graph::grid(cloud.grid().unwrap(), &tests);
         assert!(box_windows(&graph, config));
         let run = |threads: usize, box_sums: bool| {
             let threads = NonZeroUsize::new(threads).unwrap();
-            grow_counted(cloud.positions(), &graph, config, up(cloud), threads, box_sums).0
+            grow_counted(&graph, &tests, threads, box_sums).0
         };
         let reference = run(1, false);
         assert!(!reference.regions.is_empty());
@@ -2099,7 +2219,7 @@ mod tests {
     }
 
     /// The seed queue gives `sort_unstable`'s order (ties of curvature keys, keys that share
-    /// bits, one bucket or many, one part or several), and drops exactly the closed seeds.
+    /// bits, one bucket or many), and drops exactly the closed seeds.
     #[test]
     fn the_seed_queue_gives_the_sorted_order_of_open_seeds() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -2111,9 +2231,8 @@ mod tests {
                     Seed::new(c, ((i * 7919) % n) as u32, random(&mut state) > 0.0)
                 })
                 .collect();
-            for (parts, closed) in [(1, false), (3, false), (2, true)] {
-                let chunk = n.div_ceil(parts).max(1);
-                let mut queue = SeedQueue::new(seeds.chunks(chunk).map(<[Seed]>::to_vec).collect());
+            for closed in [false, true] {
+                let mut queue = SeedQueue::new(seeds.iter().map(|s| s.0).collect());
                 // Closed: every third point.
                 let is_closed = |p: usize| closed && p.is_multiple_of(3);
                 let mut expected: Vec<Seed> =
@@ -2124,7 +2243,7 @@ mod tests {
                     got.push(s);
                     queue.pop();
                 }
-                assert_eq!(got, expected, "{n} seeds, {parts} parts, closed {closed}");
+                assert_eq!(got, expected, "{n} seeds, closed {closed}");
             }
         }
     }
