@@ -2079,6 +2079,26 @@ mod tests {
         assert_eq!(AngleTest { needed: 0.1 }.passes(&zero, &a, &nan, &a), exact(&zero, &a, 0.1));
     }
 
+    /// One σ for constant noise is each point's σ; a range whose square overflows, or noise
+    /// growing with the range, keeps one per point.
+    #[test]
+    fn one_sigma_for_constant_noise_is_each_points_sigma() {
+        let range = [0.0, 0.5, 3.0, 1e150];
+        let constant = RangeNoise { sigma_0: 0.01, sigma_r2: 0.0 };
+        let sigmas = Sigmas::new(&constant, &range);
+        assert!(matches!(sigmas, Sigmas::Same(_)));
+        for (i, &r) in range.iter().enumerate() {
+            assert_eq!(sigmas.of(i).to_bits(), constant.sigma(r).to_bits());
+        }
+        assert!(matches!(Sigmas::new(&constant, &[1.0, 1e200]), Sigmas::Each(_)));
+        let growing = RangeNoise { sigma_0: 0.0012, sigma_r2: 0.0019 };
+        let sigmas = Sigmas::new(&growing, &range);
+        assert!(matches!(sigmas, Sigmas::Each(_)));
+        for (i, &r) in range.iter().enumerate() {
+            assert_eq!(sigmas.of(i).to_bits(), growing.sigma(r).to_bits());
+        }
+    }
+
     #[test]
     fn total_order_key_orders_as_total_cmp() {
         let values = [
