@@ -1338,10 +1338,11 @@ impl Seed {
 const SEED_BUCKET_BITS: u32 = 6;
 
 /// The seeds in ascending order, sorted lazily. The key's integer range is split evenly into
-/// up to 4,096 fine buckets, 64 to a coarse bucket. An in-place counting pass orders the
-/// seeds by coarse bucket; when the growth reaches a coarse bucket, it loses the seeds whose
-/// points are taken or spent by then and is ordered by fine bucket the same way; a fine
-/// bucket is sorted when the growth reaches it, again without the seeds closed by then. That
+/// up to 4,096 fine buckets, 64 to a coarse bucket. The seeds come in shares (one per seed
+/// thread), and each share is ordered by coarse bucket in place, the shares on threads of
+/// their own. When the growth reaches a coarse bucket, each share's part of it loses the
+/// seeds whose points are taken or spent by then and is ordered by fine bucket the same way;
+/// when the growth reaches a fine bucket, its open seeds from every share are sorted. That
 /// drops nothing still to be tried: between two seeds a taken point stays taken (a dissolved
 /// region frees only the points it took, before the next seed) and a spent one stays spent.
 /// On a VGA frame most seeds are taken before their bucket comes up, so this replaces
@@ -1349,79 +1350,115 @@ const SEED_BUCKET_BITS: u32 = 6;
 /// and with at most 64 buckets per pass the in-place passes write to 64 places at a time,
 /// which stay in cache (4,096 at once cost a cache and TLB miss per seed).
 struct SeedQueue {
-    /// The seeds: by coarse bucket; the current coarse bucket by fine bucket.
+    /// The seeds; each share by coarse bucket, its part of the current coarse bucket by fine
+    /// bucket.
     seeds: Vec<Seed>,
     /// The smallest key, and the shift that maps `key - min` to its fine bucket's index over
     /// all coarse buckets.
     min: u64,
     shift: u32,
-    /// `seeds[coarse[c]..coarse[c + 1]]` is coarse bucket `c`; the next one to prepare.
-    coarse: Vec<usize>,
+    shares: Vec<QueueShare>,
+    coarse_buckets: usize,
+    /// The next coarse bucket to prepare, and the next fine bucket of the current one
+    /// ([`FINE_BUCKETS`]: none left).
     next_coarse: usize,
-    /// The current coarse bucket's open seeds, by fine bucket (bounds as `coarse`); the next
-    /// fine bucket to prepare.
-    fine: Vec<usize>,
     next_fine: usize,
-    /// The prepared (open, sorted) seeds of the current fine bucket still to come:
-    /// `next..end`.
+    /// The current fine bucket's open seeds, sorted, and the next of them.
+    current: Vec<Seed>,
     next: usize,
-    end: usize,
+}
+
+/// Fine buckets per coarse bucket of a [`SeedQueue`].
+const FINE_BUCKETS: usize = 1 << SEED_BUCKET_BITS;
+
+/// One share of a [`SeedQueue`]'s seeds: `seeds[coarse[c]..coarse[c + 1]]` is its part of
+/// coarse bucket `c`, and `seeds[fine[f]..fine[f + 1]]` its open seeds of fine bucket `f` of
+/// the current coarse bucket.
+struct QueueShare {
+    coarse: Vec<usize>,
+    fine: Vec<usize>,
 }
 
 impl SeedQueue {
-    /// The queue of `packed` seeds ([`Seed`]'s `u128`), in any order.
-    fn new(packed: Vec<u128>) -> SeedQueue {
+    /// The queue of the packed seeds ([`Seed`]'s `u128`) `packed[r]` of each share `r` (in
+    /// ascending order, not overlapping; the rest of `packed` is ignored), each in any order.
+    fn new(packed: Vec<u128>, shares: &[std::ops::Range<usize>]) -> SeedQueue {
         let mut seeds: Vec<Seed> = packed.into_iter().map(Seed).collect();
-        let (min, max) =
-            seeds.iter().fold((u64::MAX, 0), |(lo, hi), s| (lo.min(s.key()), hi.max(s.key())));
-        let (min, max) = if seeds.is_empty() { (0, 0) } else { (min, max) };
+        let (min, max) = shares
+            .iter()
+            .flat_map(|r| &seeds[r.clone()])
+            .fold((u64::MAX, 0), |(lo, hi), s| (lo.min(s.key()), hi.max(s.key())));
+        let (min, max) = if min > max { (0, 0) } else { (min, max) };
         let shift = (u64::BITS - (max - min).leading_zeros()).saturating_sub(2 * SEED_BUCKET_BITS);
-        let buckets = (((max - min) >> shift >> SEED_BUCKET_BITS) + 1) as usize;
-        let coarse = partition_seeds(&mut seeds, buckets, |s| {
-            ((s.key() - min) >> shift >> SEED_BUCKET_BITS) as usize
+        let coarse_buckets = (((max - min) >> shift >> SEED_BUCKET_BITS) + 1) as usize;
+        // Each share's slice, with its offset.
+        let mut slices = Vec::with_capacity(shares.len());
+        let (mut rest, mut offset) = (&mut seeds[..], 0);
+        for r in shares {
+            let (_, tail) = std::mem::take(&mut rest).split_at_mut(r.start - offset);
+            let (share, tail) = tail.split_at_mut(r.len());
+            slices.push((r.start, share));
+            (rest, offset) = (tail, r.end);
+        }
+        let shares = in_parts(slices, |(start, share)| {
+            let coarse = partition_seeds(share, coarse_buckets, |s| {
+                ((s.key() - min) >> shift >> SEED_BUCKET_BITS) as usize
+            });
+            QueueShare { coarse: coarse.into_iter().map(|k| start + k).collect(), fine: Vec::new() }
         });
         SeedQueue {
             seeds,
             min,
             shift,
-            coarse,
+            shares,
+            coarse_buckets,
             next_coarse: 0,
-            fine: vec![0],
-            next_fine: 0,
+            next_fine: FINE_BUCKETS,
+            current: Vec::new(),
             next: 0,
-            end: 0,
         }
     }
 
     /// The next seed, without taking it; `closed(point)`: whether a point is taken or spent.
     fn peek(&mut self, closed: impl Fn(usize) -> bool) -> Option<Seed> {
-        while self.next == self.end {
-            if let (Some(&a), Some(&b)) =
-                (self.fine.get(self.next_fine), self.fine.get(self.next_fine + 1))
-            {
+        loop {
+            if let Some(&seed) = self.current.get(self.next) {
+                return Some(seed);
+            }
+            if self.next_fine < FINE_BUCKETS {
+                let f = self.next_fine;
                 self.next_fine += 1;
-                let open = a + retain_open(&mut self.seeds[a..b], &closed);
-                self.seeds[a..open].sort_unstable();
-                (self.next, self.end) = (a, open);
+                self.current.clear();
+                self.next = 0;
+                for share in &self.shares {
+                    if let (Some(&a), Some(&b)) = (share.fine.get(f), share.fine.get(f + 1)) {
+                        let open = self.seeds[a..b].iter().filter(|s| !closed(s.point()));
+                        self.current.extend(open);
+                    }
+                }
+                self.current.sort_unstable();
                 continue;
             }
-            let (&a, &b) =
-                (self.coarse.get(self.next_coarse)?, self.coarse.get(self.next_coarse + 1)?);
+            if self.next_coarse >= self.coarse_buckets {
+                return None;
+            }
+            let c = self.next_coarse;
             self.next_coarse += 1;
-            let open = a + retain_open(&mut self.seeds[a..b], &closed);
-            let (min, shift, mask) = (self.min, self.shift, (1 << SEED_BUCKET_BITS) - 1);
-            let fine = partition_seeds(&mut self.seeds[a..open], 1 << SEED_BUCKET_BITS, |s| {
-                ((s.key() - min) >> shift) as usize & mask
-            });
-            self.fine = fine.into_iter().map(|k| a + k).collect();
             self.next_fine = 0;
+            let (min, shift) = (self.min, self.shift);
+            let fine_of = |s: &Seed| ((s.key() - min) >> shift) as usize & (FINE_BUCKETS - 1);
+            for share in &mut self.shares {
+                let (a, b) = (share.coarse[c], share.coarse[c + 1]);
+                let open = a + retain_open(&mut self.seeds[a..b], &closed);
+                let fine = partition_seeds(&mut self.seeds[a..open], FINE_BUCKETS, fine_of);
+                share.fine = fine.into_iter().map(|k| a + k).collect();
+            }
         }
-        Some(self.seeds[self.next])
     }
 
     /// Takes the seed [`peek`](Self::peek) gave.
     fn pop(&mut self) {
-        debug_assert!(self.next < self.end);
+        debug_assert!(self.next < self.current.len());
         self.next += 1;
     }
 }
@@ -1799,37 +1836,34 @@ fn grow_counted(
     // the order does not depend on the split.
     let with_normals = config.max_normal_angle.is_some();
     let parts = threads.get().min(n.div_ceil(PARALLEL_SEEDS_MIN)).max(1);
-    let (seeds, mut window_normal) = if let Graph::Grid { grid, .. } = graph
+    let (seeds, shares, mut window_normal) = if let Graph::Grid { grid, .. } = graph
         && box_sums
         && box_windows(graph, config)
     {
         // Bands of whole tiles of rows, one per part. The seeds go to one zeroed buffer (its
         // pages are touched only where written), at most one per pixel: each band writes
-        // its seeds at the start of its rows' share, and the shares are closed up after.
+        // its seeds at the start of its rows' share.
         let (w, h) = (grid.width() as usize, grid.height() as usize);
         let band = (h.div_ceil(parts).div_ceil(TILE) * TILE).max(1);
         let mut packed = vec![0u128; w * h];
-        let shares: Vec<_> = (0..h).step_by(band).zip(packed.chunks_mut(band * w)).collect();
-        let counts = in_parts(shares, |(r0, out)| {
+        let bands: Vec<_> = (0..h).step_by(band).zip(packed.chunks_mut(band * w)).collect();
+        let counts = in_parts(bands, |(r0, out)| {
             seeds_in_rows(r0..(r0 + band).min(h), points, graph, tests, out)
         });
-        let mut len = 0;
-        for (k, count) in counts.into_iter().enumerate() {
-            packed.copy_within(k * band * w..k * band * w + count, len);
-            len += count;
-        }
-        packed.truncate(len);
-        (packed, Vec::new())
+        let shares = counts.iter().enumerate().map(|(k, &c)| k * band * w..k * band * w + c);
+        (packed, shares.collect(), Vec::new())
     } else {
         let chunk = n.div_ceil(parts);
         let ranges: Vec<_> = (0..parts).map(|k| k * chunk..((k + 1) * chunk).min(n)).collect();
         let found = in_parts(ranges, |range| seeds_in(range, points, graph, tests, with_normals));
         let (seeds, normals): (Vec<_>, Vec<_>) = found.into_iter().unzip();
-        (seeds.into_iter().flatten().map(|s| s.0).collect(), normals.concat())
+        let packed: Vec<u128> = seeds.into_iter().flatten().map(|s| s.0).collect();
+        let all = vec![0..packed.len()];
+        (packed, all, normals.concat())
     };
     let mut window = Vec::new();
     // Flattest first, ties by index (the seeds are distinct: one per point).
-    let mut seeds = SeedQueue::new(seeds);
+    let mut seeds = SeedQueue::new(seeds, &shares);
     // Seeds fitted on the way, by exact curvature.
     let mut fitted: BinaryHeap<Reverse<Seed>> = BinaryHeap::new();
     let mut scratch = Vec::new();
@@ -2239,7 +2273,8 @@ mod tests {
     }
 
     /// The seed queue gives `sort_unstable`'s order (ties of curvature keys, keys that share
-    /// bits, one bucket or many), and drops exactly the closed seeds.
+    /// bits, one bucket or many, one share or several, with gaps between them), and drops
+    /// exactly the closed seeds.
     #[test]
     fn the_seed_queue_gives_the_sorted_order_of_open_seeds() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -2251,8 +2286,16 @@ mod tests {
                     Seed::new(c, ((i * 7919) % n) as u32, random(&mut state) > 0.0)
                 })
                 .collect();
-            for closed in [false, true] {
-                let mut queue = SeedQueue::new(seeds.iter().map(|s| s.0).collect());
+            for (parts, closed) in [(1, false), (3, false), (2, true)] {
+                // The shares in a buffer with a gap of zeros before each.
+                let chunk = n.div_ceil(parts).max(1);
+                let (mut packed, mut shares) = (Vec::new(), Vec::new());
+                for part in seeds.chunks(chunk) {
+                    packed.extend([0, 0]);
+                    shares.push(packed.len()..packed.len() + part.len());
+                    packed.extend(part.iter().map(|s| s.0));
+                }
+                let mut queue = SeedQueue::new(packed, &shares);
                 // Closed: every third point.
                 let is_closed = |p: usize| closed && p.is_multiple_of(3);
                 let mut expected: Vec<Seed> =
@@ -2263,7 +2306,7 @@ mod tests {
                     got.push(s);
                     queue.pop();
                 }
-                assert_eq!(got, expected, "{n} seeds, closed {closed}");
+                assert_eq!(got, expected, "{n} seeds, {parts} shares, closed {closed}");
             }
         }
     }
