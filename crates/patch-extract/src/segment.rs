@@ -1286,17 +1286,30 @@ fn bending(
     }
     let e1: Vector3 = fit.eigenvectors.column(1).into_owned() / s1;
     let e2: Vector3 = fit.eigenvectors.column(2).into_owned() / s2;
-    let mut a = nalgebra::Matrix6::<Real>::zeros();
-    let mut b = nalgebra::Vector6::<Real>::zeros();
+    // `a += w φ φᵀ` (its lower triangle) and `b += w d φ` per point, in the operations of
+    // nalgebra's `syger` and `axpy` (each product rounded, then added), so the sums are
+    // theirs bit for bit, without their general-size loops.
+    let mut lower = [[0.0; 6]; 6];
+    let mut rhs = [0.0; 6];
     for &i in region {
         let q = points[i as usize] - fit.centroid;
         let (u, v, d) = (q.dot(&e1), q.dot(&e2), q.dot(&normal));
         let s = sigma.of(i as usize);
         let w = 1.0 / (s * s);
-        let phi = nalgebra::Vector6::new(1.0, u, v, u * u, u * v, v * v);
-        a.syger(w, &phi, &phi, 1.0);
-        b.axpy(w * d, &phi, 1.0);
+        let phi = [1.0, u, v, u * u, u * v, v * v];
+        for j in 0..6 {
+            let wj = w * phi[j];
+            for k in j..6 {
+                lower[k][j] += wj * phi[k];
+            }
+        }
+        let wd = w * d;
+        for k in 0..6 {
+            rhs[k] += wd * phi[k];
+        }
     }
+    let a = nalgebra::Matrix6::<Real>::from_fn(|r, c| if r >= c { lower[r][c] } else { 0.0 });
+    let b = nalgebra::Vector6::<Real>::from(rhs);
     let full = a.cholesky()?.solve(&b);
     let a3 = a.fixed_view::<3, 3>(0, 0).into_owned();
     let b3 = b.fixed_rows::<3>(0).into_owned();
