@@ -1795,6 +1795,8 @@ fn seeds_in_rows(
 struct Grown {
     len: usize,
     acc: PlaneAccumulator,
+    /// Refused by the bending test: its points go to the remainder.
+    bent: bool,
 }
 
 fn grow(graph: &Graph<'_>, tests: &Tests<'_>, threads: NonZeroUsize) -> Segmentation {
@@ -1870,9 +1872,14 @@ fn grow_counted(
         let ranges: Vec<_> = (0..parts).map(|k| k * chunk..((k + 1) * chunk).min(n)).collect();
         let found = in_parts(ranges, |range| seeds_in(range, points, graph, tests, with_normals));
         let (seeds, normals): (Vec<_>, Vec<_>) = found.into_iter().unzip();
+        // One share per part, back to back.
+        let ends = seeds.iter().scan(0, |end, part| {
+            *end += part.len();
+            Some(*end - part.len()..*end)
+        });
+        let shares: Vec<_> = ends.collect();
         let packed: Vec<u128> = seeds.into_iter().flatten().map(|s| s.0).collect();
-        let all = vec![0..packed.len()];
-        (packed, all, normals.concat())
+        (packed, shares, normals.concat())
     };
     let mut window = Vec::new();
     // Flattest first, ties by index (the seeds are distinct: one per point).
@@ -1890,158 +1897,190 @@ fn grow_counted(
     let mut grown: Vec<Grown> = Vec::new();
     let mut queue: Vec<u32> = Vec::new();
     let mut nbrs = Vec::new();
-    loop {
-        let next = seeds.peek(closed(&owner, &spent));
-        let from_list = match (next, fitted.peek()) {
-            (Some(s), Some(Reverse(f))) => s < *f,
-            (Some(_), None) => true,
-            (None, Some(_)) => false,
-            (None, None) => break,
-        };
-        let (seed, unfitted) = if let (true, Some(s)) = (from_list, next) {
-            seeds.pop();
-            (s.point(), !s.fitted())
+    // The bending test of a grown region (module docs, step 6) decides only whether its
+    // points end in the region or in the remainder, not the growth after it (either way they
+    // are taken). So on a cloud large enough for several parts it runs on a thread of its
+    // own while the growth goes on; the result is the same.
+    let is_bent = |region: &[u32], acc: &PlaneAccumulator| {
+        config.max_bending.is_some_and(|b| {
+            bending(points, region, &tests.sigma, acc)
+                .is_some_and(|d| d > CHI2_3_999 && d > region.len() as Real * b * b)
+        })
+    };
+    std::thread::scope(|scope| {
+        let (bending_jobs, bending_worker) = if parts > 1 && config.max_bending.is_some() {
+            let (jobs, received) =
+                std::sync::mpsc::channel::<(usize, Vec<u32>, PlaneAccumulator)>();
+            let worker = scope.spawn(move || {
+                received.into_iter().map(|(k, region, acc)| (k, is_bent(&region, &acc))).collect()
+            });
+            (Some(jobs), Some(worker))
         } else {
-            let Some(Reverse(s)) = fitted.pop() else { break };
-            (s.point(), false)
+            (None, None)
         };
-        if owner[seed] != FREE || spent[seed] {
-            continue;
-        }
-        let _ = graph.seed_window(seed, &mut window);
-        if window.iter().any(|&(p, _)| owner[p as usize] != FREE) {
-            continue;
-        }
-        let mut acc =
-            PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
-        let mut fit_now = None;
-        if unfitted {
-            // Its turn comes now unless another seed comes before its exact curvature; then
-            // it waits for its turn (its point and window are checked again then). Most
-            // seeds wait and are taken by others, so the curvature comes without the
-            // eigendecomposition where the bounds allow.
-            let curvature = match acc.polished_curvature() {
-                Some(c) => c,
-                None => {
-                    let Some(fit) = acc.fit(&origin) else { continue };
-                    fit_now = Some(fit);
-                    fit.curvature()
-                }
+        loop {
+            let next = seeds.peek(closed(&owner, &spent));
+            let from_list = match (next, fitted.peek()) {
+                (Some(s), Some(Reverse(f))) => s < *f,
+                (Some(_), None) => true,
+                (None, Some(_)) => false,
+                (None, None) => break,
             };
-            let exact = Seed::new(curvature, seed as u32, true);
-            if seeds.peek(closed(&owner, &spent)).is_some_and(|s| s < exact)
-                || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
-            {
-                fitted.push(Reverse(exact));
+            let (seed, unfitted) = if let (true, Some(s)) = (from_list, next) {
+                seeds.pop();
+                (s.point(), !s.fitted())
+            } else {
+                let Some(Reverse(s)) = fitted.pop() else { break };
+                (s.point(), false)
+            };
+            if owner[seed] != FREE || spent[seed] {
                 continue;
             }
-        }
-        let Some(fit) = fit_now.or_else(|| acc.fit(&origin)) else { continue };
-        let mut sum_sigma2: Real =
-            window.iter().map(|&(p, _)| tests.sigma.of(p as usize).powi(2)).sum();
-        if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
-            || !tests.facing(&fit, true)
-            || !window.iter().all(|&(p, _)| tests.near_plane(&fit.plane, p as usize))
-        {
-            continue;
-        }
-        let id = grown.len() as u32;
-        queue.clear();
-        taken += window.len();
-        for &(p, _) in &window {
-            owner[p as usize] = id;
-            queue.push(p);
-        }
-        let mut plane = fit.plane;
-        let mut along = acc.moments_along(&plane.normal);
-        let mut next_refit = acc.len() + 1;
-        let mut head = 0;
-        while head < queue.len() {
-            let q = queue[head] as usize;
-            head += 1;
-            graph.neighbours(q, &mut nbrs);
-            for &(m, linked) in &nbrs {
-                let m = m as usize;
-                if owner[m] != FREE
-                    || !tests.linked_on(&plane, q, m, linked)
-                    || !tests.near_plane(&plane, m)
-                    || window_normal.get_mut(m).is_some_and(|w| {
-                        let refused = |w: &Vector3| {
-                            *w != Vector3::zeros() && w.dot(&plane.normal).abs() < min_normal_cos
-                        };
-                        let (normal, error) = *w;
-                        if error == 0.0 {
-                            return refused(&normal);
-                        }
-                        let cos = normal.dot(&plane.normal).abs();
-                        if cos - error > min_normal_cos + 1e-12 {
-                            return false;
-                        }
-                        if cos + error < min_normal_cos - 1e-12 {
-                            return true;
-                        }
-                        // The bound cannot decide: fit the window.
-                        let _ = graph.seed_window(m, &mut scratch);
-                        let acc = PlaneAccumulator::from_points(
-                            scratch.iter().map(|&(p, _)| &points[p as usize]),
-                        );
-                        let normal = acc
-                            .fit(&origin)
-                            .map_or(Vector3::zeros(), |f| f.plane.normal.into_inner());
-                        *w = (normal, 0.0);
-                        refused(&normal)
-                    })
-                {
-                    continue;
-                }
-                // The MSE along the plane's normal with `m` added (the Rayleigh quotient
-                // `nᵀ S' n / (n + 1)` from the running sums along the normal).
-                let d = acc.offset_along(&plane.normal, &points[m]);
-                let (a, b) = (along.0 + d, along.1 + d * d);
-                let count = acc.len() + 1;
-                let mse = ((b - a * a / count as Real) / count as Real).max(0.0);
-                let s2 = sum_sigma2 + tests.sigma.of(m).powi(2);
-                if !tests.mse_ok(mse, s2, count) {
-                    continue;
-                }
-                acc.add(&points[m]);
-                along = (a, b);
-                sum_sigma2 = s2;
-                owner[m] = id;
-                taken += 1;
-                queue.push(m as u32);
-                if acc.len() >= next_refit {
-                    if let Some(f) = acc.fit(&origin) {
-                        plane = f.plane;
-                        along = acc.moments_along(&plane.normal);
+            let _ = graph.seed_window(seed, &mut window);
+            if window.iter().any(|&(p, _)| owner[p as usize] != FREE) {
+                continue;
+            }
+            let mut acc =
+                PlaneAccumulator::from_points(window.iter().map(|&(p, _)| &points[p as usize]));
+            let mut fit_now = None;
+            if unfitted {
+                // Its turn comes now unless another seed comes before its exact curvature; then
+                // it waits for its turn (its point and window are checked again then). Most
+                // seeds wait and are taken by others, so the curvature comes without the
+                // eigendecomposition where the bounds allow.
+                let curvature = match acc.polished_curvature() {
+                    Some(c) => c,
+                    None => {
+                        let Some(fit) = acc.fit(&origin) else { continue };
+                        fit_now = Some(fit);
+                        fit.curvature()
                     }
-                    next_refit = acc.len() + (acc.len() / 20).max(1);
+                };
+                let exact = Seed::new(curvature, seed as u32, true);
+                if seeds.peek(closed(&owner, &spent)).is_some_and(|s| s < exact)
+                    || fitted.peek().is_some_and(|Reverse(f)| *f < exact)
+                {
+                    fitted.push(Reverse(exact));
+                    continue;
                 }
             }
+            let Some(fit) = fit_now.or_else(|| acc.fit(&origin)) else { continue };
+            let mut sum_sigma2: Real =
+                window.iter().map(|&(p, _)| tests.sigma.of(p as usize).powi(2)).sum();
+            if !tests.mse_ok(fit.mse, sum_sigma2, acc.len())
+                || !tests.facing(&fit, true)
+                || !window.iter().all(|&(p, _)| tests.near_plane(&fit.plane, p as usize))
+            {
+                continue;
+            }
+            let id = grown.len() as u32;
+            queue.clear();
+            taken += window.len();
+            for &(p, _) in &window {
+                owner[p as usize] = id;
+                queue.push(p);
+            }
+            let mut plane = fit.plane;
+            let mut along = acc.moments_along(&plane.normal);
+            let mut next_refit = acc.len() + 1;
+            let mut head = 0;
+            while head < queue.len() {
+                let q = queue[head] as usize;
+                head += 1;
+                graph.neighbours(q, &mut nbrs);
+                for &(m, linked) in &nbrs {
+                    let m = m as usize;
+                    if owner[m] != FREE
+                        || !tests.linked_on(&plane, q, m, linked)
+                        || !tests.near_plane(&plane, m)
+                        || window_normal.get_mut(m).is_some_and(|w| {
+                            let refused = |w: &Vector3| {
+                                *w != Vector3::zeros()
+                                    && w.dot(&plane.normal).abs() < min_normal_cos
+                            };
+                            let (normal, error) = *w;
+                            if error == 0.0 {
+                                return refused(&normal);
+                            }
+                            let cos = normal.dot(&plane.normal).abs();
+                            if cos - error > min_normal_cos + 1e-12 {
+                                return false;
+                            }
+                            if cos + error < min_normal_cos - 1e-12 {
+                                return true;
+                            }
+                            // The bound cannot decide: fit the window.
+                            let _ = graph.seed_window(m, &mut scratch);
+                            let acc = PlaneAccumulator::from_points(
+                                scratch.iter().map(|&(p, _)| &points[p as usize]),
+                            );
+                            let normal = acc
+                                .fit(&origin)
+                                .map_or(Vector3::zeros(), |f| f.plane.normal.into_inner());
+                            *w = (normal, 0.0);
+                            refused(&normal)
+                        })
+                    {
+                        continue;
+                    }
+                    // The MSE along the plane's normal with `m` added (the Rayleigh quotient
+                    // `nᵀ S' n / (n + 1)` from the running sums along the normal).
+                    let d = acc.offset_along(&plane.normal, &points[m]);
+                    let (a, b) = (along.0 + d, along.1 + d * d);
+                    let count = acc.len() + 1;
+                    let mse = ((b - a * a / count as Real) / count as Real).max(0.0);
+                    let s2 = sum_sigma2 + tests.sigma.of(m).powi(2);
+                    if !tests.mse_ok(mse, s2, count) {
+                        continue;
+                    }
+                    acc.add(&points[m]);
+                    along = (a, b);
+                    sum_sigma2 = s2;
+                    owner[m] = id;
+                    taken += 1;
+                    queue.push(m as u32);
+                    if acc.len() >= next_refit {
+                        if let Some(f) = acc.fit(&origin) {
+                            plane = f.plane;
+                            along = acc.moments_along(&plane.normal);
+                        }
+                        next_refit = acc.len() + (acc.len() / 20).max(1);
+                    }
+                }
+            }
+            if queue.len() < config.min_region_size {
+                for &p in &queue {
+                    owner[p as usize] = FREE;
+                }
+            } else if !acc.fit(&origin).is_some_and(|f| tests.facing(&f, false)) {
+                for &p in &queue {
+                    owner[p as usize] = FREE;
+                    spent[p as usize] = true;
+                }
+            } else {
+                let bent = match &bending_jobs {
+                    Some(jobs) => {
+                        // An error means the worker panicked, which its join passes on.
+                        let _ = jobs.send((grown.len(), queue.clone(), acc));
+                        false
+                    }
+                    None => is_bent(&queue, &acc),
+                };
+                grown.push(Grown { len: queue.len(), acc, bent });
+            }
         }
-        if queue.len() < config.min_region_size {
-            for &p in &queue {
-                owner[p as usize] = FREE;
+        drop(bending_jobs);
+        if let Some(worker) = bending_worker {
+            let results: Vec<(usize, bool)> =
+                worker.join().unwrap_or_else(|e| std::panic::resume_unwind(e));
+            for (k, bent) in results {
+                grown[k].bent = bent;
             }
-        } else if !acc.fit(&origin).is_some_and(|f| tests.facing(&f, false)) {
-            for &p in &queue {
-                owner[p as usize] = FREE;
-                spent[p as usize] = true;
-            }
-        } else if config.max_bending.is_some_and(|b| {
-            bending(points, &queue, &tests.sigma, &acc)
-                .is_some_and(|d| d > CHI2_3_999 && d > queue.len() as Real * b * b)
-        }) {
-            for &p in &queue {
-                owner[p as usize] = BENT;
-            }
-        } else {
-            grown.push(Grown { len: queue.len(), acc });
         }
-    }
+    });
 
     // Each region's points in ascending order, from one pass over the owners (the owner of
-    // every point of a kept region is its index in `grown`; dissolved regions freed theirs).
+    // every point of a grown region is its index in `grown`; dissolved regions freed theirs).
     let mut ascending: Vec<Vec<u32>> = grown.iter().map(|g| Vec::with_capacity(g.len)).collect();
     for (i, &o) in owner.iter().enumerate() {
         if let Some(list) = ascending.get_mut(o as usize) {
@@ -2051,6 +2090,12 @@ fn grow_counted(
     let mut regions = Vec::with_capacity(grown.len());
     for (g, pts) in grown.into_iter().zip(ascending) {
         debug_assert_eq!(pts.len(), g.len);
+        if g.bent {
+            for &p in &pts {
+                owner[p as usize] = BENT;
+            }
+            continue;
+        }
         match g.acc.fit(&origin) {
             Some(fit) if tests.facing(&fit, false) => regions.push(region_from_fit(pts, &fit)),
             _ => {
@@ -2251,6 +2296,33 @@ mod tests {
             ..SegmentConfig::range_camera()
         };
         assert_box_sums_agree(&cloud, &config);
+    }
+
+    /// A bent region goes to the remainder whether its bending test runs at once (one
+    /// thread) or beside the growth (two): a flat half and a curved half of a frame large
+    /// enough for two parts, a metre apart in depth.
+    #[test]
+    fn the_bending_test_beside_the_growth_gives_the_same_segmentation() {
+        let (w, h) = (400u32, 300u32);
+        let mut state = 0x1234_5678_9abc_def1u64;
+        let pixels: Vec<Option<Point3>> = (0..h)
+            .flat_map(|row| (0..w).map(move |col| (row, col)))
+            .map(|(row, col)| {
+                let (x, y) = (Real::from(col) * 0.005 - 1.0, Real::from(row) * 0.005 - 0.75);
+                let z = if col < w / 2 { 3.0 } else { 4.0 + 0.1 * (x - 0.5).powi(2) };
+                Some(Point3::new(x, y, z + 0.002 * random(&mut state)))
+            })
+            .collect();
+        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+        let config = SegmentConfig::range_camera();
+        let one = segment_with_threads(&cloud, &config, NonZeroUsize::MIN).unwrap();
+        let two = segment_with_threads(&cloud, &config, NonZeroUsize::new(2).unwrap()).unwrap();
+        assert_eq!(one, two);
+        // The flat half is a region; the curved half is grown, refused as bent, and left over.
+        let half = (w * h / 2) as usize;
+        assert!(one.regions.iter().any(|r| r.points.len() > half * 9 / 10));
+        let curved_left = one.remainder.iter().filter(|&&i| i % w >= w / 2).count();
+        assert!(curved_left > half * 9 / 10, "{curved_left} curved points in the remainder");
     }
 
     /// The curvature floor of windows whose bounds fail is at most the fitted curvature.
