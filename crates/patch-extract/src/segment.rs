@@ -83,7 +83,9 @@
 //!    fails the incidence test is dissolved. Points in no region form the remainder.
 //!
 //! # Complexity
-//! Seeding is O(N w) for windows of `w` points plus an O(N log N) sort. Growth tests each
+//! Seeding is O(N w) for windows of `w` points plus O(N) to bucket the seeds and an
+//! O(N log N) sort at worst (in practice only the seeds still open when their bucket comes up
+//! are sorted). Growth tests each
 //! neighbour of every accepted point once per acceptance, O(N α) in total where α is the
 //! average number of regions (grown or dissolved) that reach a point, bounded by
 //! `4 × (1 + dissolutions touching it)`; dissolved regions are smaller than
@@ -120,7 +122,10 @@
 //!
 //! The seeds' bounds are independent per point: [`segment_with_threads`] (and the pipeline,
 //! with the cores its scans leave free) computes them for large organised clouds on several
-//! threads and sorts them as one list, so the segmentation does not depend on the count.
+//! threads and orders them as one list, so the segmentation does not depend on the count.
+//! The bending test of a grown region decides only whether its points stay in it or go to
+//! the remainder, not the growth after it, so with a second thread it runs there while the
+//! growth goes on.
 //!
 //! # Actuated LRF scans
 //! The ±90° beam column of an actuated LRF sees one line in every row (thesis App. A); run
