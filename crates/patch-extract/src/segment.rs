@@ -1681,7 +1681,7 @@ fn box_windows(graph: &Graph<'_>, config: &SegmentConfig) -> bool {
 /// Any other window, or one whose sums are not precise enough ([`BOX_SUM_MAX_SPREAD`]), goes
 /// through [`seed_of`]. The bounds are certified either way, so the segmentation is the same
 /// (module docs, "Performance"). Writes the packed seeds ([`Seed`]'s `u128`) to the start of
-/// `out`, which has room for one per pixel of `rows`; returns how many.
+/// `out`, which has room for one per valid pixel of `rows`; returns how many.
 fn seeds_in_rows(
     rows: std::ops::Range<usize>,
     points: &[Point3],
@@ -1861,28 +1861,40 @@ fn grow_counted(
         && box_windows(graph, config)
     {
         // Bands of whole tiles of rows, one per part. The seeds go to one zeroed buffer (its
-        // pages are touched only where written), at most one per pixel: each band writes
-        // its seeds at the start of its rows' share.
+        // pages are touched only where written) with room for one per valid pixel: each band
+        // writes its seeds at the start of its share of it.
         let (w, h) = (grid.width() as usize, grid.height() as usize);
         let band = (h.div_ceil(parts).div_ceil(TILE) * TILE).max(1);
-        let mut packed = vec![0u128; w * h];
-        let bands: Vec<_> = (0..h).step_by(band).zip(packed.chunks_mut(band * w)).collect();
-        let counts = in_parts(bands, |(r0, out)| {
-            seeds_in_rows(r0..(r0 + band).min(h), points, graph, tests, out)
-        });
-        let shares = counts.iter().enumerate().map(|(k, &c)| k * band * w..k * band * w + c);
-        (packed, shares.collect(), Vec::new())
+        let rows: Vec<_> = (0..h).step_by(band).map(|r0| r0..(r0 + band).min(h)).collect();
+        let room: Vec<usize> = rows
+            .iter()
+            .map(|r| {
+                grid.pixels()[r.start * w..r.end * w]
+                    .iter()
+                    .filter(|&&p| p != INVALID_PIXEL)
+                    .count()
+            })
+            .collect();
+        let mut packed = vec![0u128; room.iter().sum()];
+        let mut bands = Vec::with_capacity(rows.len());
+        let mut rest = &mut packed[..];
+        for (r, &k) in rows.into_iter().zip(&room) {
+            let (share, tail) = std::mem::take(&mut rest).split_at_mut(k);
+            bands.push((r, share));
+            rest = tail;
+        }
+        let counts = in_parts(bands, |(r, out)| seeds_in_rows(r, points, graph, tests, out));
+        let shares = offsets(&room).zip(counts).map(|(start, count)| start..start + count);
+        (packed, shares.collect::<Vec<_>>(), Vec::new())
     } else {
         let chunk = n.div_ceil(parts);
         let ranges: Vec<_> = (0..parts).map(|k| k * chunk..((k + 1) * chunk).min(n)).collect();
         let found = in_parts(ranges, |range| seeds_in(range, points, graph, tests, with_normals));
         let (seeds, normals): (Vec<_>, Vec<_>) = found.into_iter().unzip();
         // One share per part, back to back.
-        let ends = seeds.iter().scan(0, |end, part| {
-            *end += part.len();
-            Some(*end - part.len()..*end)
-        });
-        let shares: Vec<_> = ends.collect();
+        let lens: Vec<usize> = seeds.iter().map(Vec::len).collect();
+        let shares: Vec<_> =
+            offsets(&lens).zip(&lens).map(|(start, len)| start..start + len).collect();
         let packed: Vec<u128> = seeds.into_iter().flatten().map(|s| s.0).collect();
         (packed, shares, normals.concat())
     };
@@ -2113,6 +2125,14 @@ fn grow_counted(
     sort_largest_first(&mut regions);
     let remainder = (0..n as u32).filter(|&i| matches!(owner[i as usize], FREE | BENT)).collect();
     (Segmentation { regions, remainder }, taken)
+}
+
+/// Where each of slices of lengths `lens` starts when they lie back to back from 0.
+fn offsets(lens: &[usize]) -> impl Iterator<Item = usize> + '_ {
+    lens.iter().scan(0, |end, len| {
+        *end += len;
+        Some(*end - len)
+    })
 }
 
 /// Whether a point is closed to seeds: taken by a region (or bent) or spent.
