@@ -2350,6 +2350,29 @@ mod tests {
         assert!(curved_left > half * 9 / 10, "{curved_left} curved points in the remainder");
     }
 
+    /// A frame whose lower half has no valid pixel, large enough for two seed threads: the
+    /// second band has no room for seeds and finds none, and the result is that of one
+    /// thread.
+    #[test]
+    fn a_seed_band_without_valid_pixels_gives_the_segmentation_of_one_thread() {
+        let (w, h) = (500u32, 480u32);
+        let mut state = 0x0f1e_2d3c_4b5a_6978u64;
+        let pixels: Vec<Option<Point3>> = (0..h)
+            .flat_map(|row| (0..w).map(move |col| (row, col)))
+            .map(|(row, col)| {
+                let (x, y) = (Real::from(col) * 0.005 - 1.25, Real::from(row) * 0.005 - 0.6);
+                (row < h / 2).then(|| Point3::new(x, y, 3.0 + 0.2 * y + 0.002 * random(&mut state)))
+            })
+            .collect();
+        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+        assert!(cloud.len() >= 2 * PARALLEL_SEEDS_MIN);
+        let config = SegmentConfig::range_camera();
+        let one = segment_with_threads(&cloud, &config, NonZeroUsize::MIN).unwrap();
+        let two = segment_with_threads(&cloud, &config, NonZeroUsize::new(2).unwrap()).unwrap();
+        assert_eq!(one, two);
+        assert_eq!(one.regions.len(), 1);
+    }
+
     /// The curvature floor of windows whose bounds fail is at most the fitted curvature.
     #[test]
     fn curvature_floors_are_below_the_fit() {
