@@ -2166,6 +2166,29 @@ mod tests {
         (*state >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
     }
 
+    /// A `w × h` organised frame: pixel (column, row) is `pixel(column, row, state)`, `state`
+    /// the [`random`] state started at `seed`.
+    fn frame(
+        (w, h): (u32, u32),
+        seed: u64,
+        mut pixel: impl FnMut(u32, u32, &mut u64) -> Option<Point3>,
+    ) -> PointCloud {
+        let mut state = seed;
+        let pixels: Vec<Option<Point3>> = (0..h)
+            .flat_map(|row| (0..w).map(move |col| (row, col)))
+            .map(|(row, col)| pixel(col, row, &mut state))
+            .collect();
+        PointCloud::from_pixels(w, h, pixels).unwrap()
+    }
+
+    /// The segmentation of `cloud` on one thread, checked to be that on two.
+    fn segment_on_one_and_two_threads(cloud: &PointCloud, config: &SegmentConfig) -> Segmentation {
+        let one = segment_with_threads(cloud, config, NonZeroUsize::MIN).unwrap();
+        let two = segment_with_threads(cloud, config, NonZeroUsize::new(2).unwrap()).unwrap();
+        assert_eq!(one, two);
+        one
+    }
+
     #[test]
     fn angle_test_agrees_with_atan2() {
         let mut state = 0x853c_49e6_748f_ea9bu64;
@@ -2298,22 +2321,16 @@ mod tests {
             assert_box_sums_agree(&cloud, &SegmentConfig::structured_light());
         }
 
-        let (w, h) = (200u32, 150u32);
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let pixels: Vec<Option<Point3>> = (0..h)
-            .flat_map(|row| (0..w).map(move |col| (row, col)))
-            .map(|(row, col)| {
-                let noise = 0.002 * random(&mut state);
-                if random(&mut state) > 0.995 {
-                    return None;
-                }
-                // Columns in bands of 25 at depths 40 m apart, rows tilted.
-                let band = Real::from(col / 25);
-                let (x, y) = (Real::from(col) * 0.01, Real::from(row) * 0.01);
-                Some(Point3::new(x, y, 500.0 + 40.0 * band + 0.2 * y + noise))
-            })
-            .collect();
-        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+        let cloud = frame((200, 150), 0x9e37_79b9_7f4a_7c15, |col, row, state| {
+            let noise = 0.002 * random(state);
+            if random(state) > 0.995 {
+                return None;
+            }
+            // Columns in bands of 25 at depths 40 m apart, rows tilted.
+            let band = Real::from(col / 25);
+            let (x, y) = (Real::from(col) * 0.01, Real::from(row) * 0.01);
+            Some(Point3::new(x, y, 500.0 + 40.0 * band + 0.2 * y + noise))
+        });
         let config = SegmentConfig {
             noise: RangeNoise { sigma_0: 0.002, sigma_r2: 0.0 },
             jump_absolute: 0.05,
@@ -2329,20 +2346,12 @@ mod tests {
     #[test]
     fn the_bending_test_beside_the_growth_gives_the_same_segmentation() {
         let (w, h) = (400u32, 300u32);
-        let mut state = 0x1234_5678_9abc_def1u64;
-        let pixels: Vec<Option<Point3>> = (0..h)
-            .flat_map(|row| (0..w).map(move |col| (row, col)))
-            .map(|(row, col)| {
-                let (x, y) = (Real::from(col) * 0.005 - 1.0, Real::from(row) * 0.005 - 0.75);
-                let z = if col < w / 2 { 3.0 } else { 4.0 + 0.1 * (x - 0.5).powi(2) };
-                Some(Point3::new(x, y, z + 0.002 * random(&mut state)))
-            })
-            .collect();
-        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
-        let config = SegmentConfig::range_camera();
-        let one = segment_with_threads(&cloud, &config, NonZeroUsize::MIN).unwrap();
-        let two = segment_with_threads(&cloud, &config, NonZeroUsize::new(2).unwrap()).unwrap();
-        assert_eq!(one, two);
+        let cloud = frame((w, h), 0x1234_5678_9abc_def1, |col, row, state| {
+            let (x, y) = (Real::from(col) * 0.005 - 1.0, Real::from(row) * 0.005 - 0.75);
+            let z = if col < w / 2 { 3.0 } else { 4.0 + 0.1 * (x - 0.5).powi(2) };
+            Some(Point3::new(x, y, z + 0.002 * random(state)))
+        });
+        let one = segment_on_one_and_two_threads(&cloud, &SegmentConfig::range_camera());
         // The flat half is a region; the curved half is grown, refused as bent, and left over.
         let half = (w * h / 2) as usize;
         assert!(one.regions.iter().any(|r| r.points.len() > half * 9 / 10));
@@ -2355,21 +2364,13 @@ mod tests {
     /// thread.
     #[test]
     fn a_seed_band_without_valid_pixels_gives_the_segmentation_of_one_thread() {
-        let (w, h) = (500u32, 480u32);
-        let mut state = 0x0f1e_2d3c_4b5a_6978u64;
-        let pixels: Vec<Option<Point3>> = (0..h)
-            .flat_map(|row| (0..w).map(move |col| (row, col)))
-            .map(|(row, col)| {
-                let (x, y) = (Real::from(col) * 0.005 - 1.25, Real::from(row) * 0.005 - 0.6);
-                (row < h / 2).then(|| Point3::new(x, y, 3.0 + 0.2 * y + 0.002 * random(&mut state)))
-            })
-            .collect();
-        let cloud = PointCloud::from_pixels(w, h, pixels).unwrap();
+        let h = 480;
+        let cloud = frame((500, h), 0x0f1e_2d3c_4b5a_6978, |col, row, state| {
+            let (x, y) = (Real::from(col) * 0.005 - 1.25, Real::from(row) * 0.005 - 0.6);
+            (row < h / 2).then(|| Point3::new(x, y, 3.0 + 0.2 * y + 0.002 * random(state)))
+        });
         assert!(cloud.len() >= 2 * PARALLEL_SEEDS_MIN);
-        let config = SegmentConfig::range_camera();
-        let one = segment_with_threads(&cloud, &config, NonZeroUsize::MIN).unwrap();
-        let two = segment_with_threads(&cloud, &config, NonZeroUsize::new(2).unwrap()).unwrap();
-        assert_eq!(one, two);
+        let one = segment_on_one_and_two_threads(&cloud, &SegmentConfig::range_camera());
         assert_eq!(one.regions.len(), 1);
     }
 
